@@ -1,0 +1,1 @@
+"""Thesis examples shared by the book, demos, exercises and tests."""

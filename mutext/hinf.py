@@ -1,0 +1,703 @@
+r"""H-infinity synthesis by linear matrix inequalities.
+
+Given a generalized plant
+
+.. math::
+    P:\quad \dot x = Ax + B_1 w + B_2 u,\quad z = C_1x + D_{11}w + D_{12}u,\quad
+    y = C_2x + D_{21}w + D_{22}u,
+
+find a stabilizing controller ``u = K y`` that minimises the H-infinity norm
+of the closed loop :math:`w \to z`.
+
+Method
+------
+1. *Optimal level* (Gahinet and Apkarian [GA]_, Theorem 4.3): a controller with
+   closed-loop norm below :math:`\gamma` exists iff there are symmetric
+   :math:`R, S` with
+
+   .. math::
+       \begin{bmatrix} N_R & 0\\ 0 & I\end{bmatrix}^T
+       \begin{bmatrix} AR + RA^T & RC_1^T & B_1\\ C_1R & -\gamma I & D_{11}\\
+       B_1^T & D_{11}^T & -\gamma I\end{bmatrix}
+       \begin{bmatrix} N_R & 0\\ 0 & I\end{bmatrix} \prec 0,\qquad
+       \begin{bmatrix} N_S & 0\\ 0 & I\end{bmatrix}^T
+       \begin{bmatrix} A^TS + SA & SB_1 & C_1^T\\ B_1^TS & -\gamma I & D_{11}^T\\
+       C_1 & D_{11} & -\gamma I\end{bmatrix}
+       \begin{bmatrix} N_S & 0\\ 0 & I\end{bmatrix} \prec 0,\qquad
+       \begin{bmatrix} R & I\\ I & S\end{bmatrix} \succeq 0,
+
+   where :math:`N_R` and :math:`N_S` span the null spaces of
+   :math:`[B_2^T\ D_{12}^T]` and :math:`[C_2\ D_{21}]`.  These are linear in
+   :math:`(R, S, \gamma)`, so the optimal level is a single semidefinite
+   program (no bisection).  No rank condition on :math:`D_{12}, D_{21}` is
+   needed: singular problems that the Riccati method refuses are handled.
+2. *Controller* at a level slightly above the optimum (``backoff``), from the
+   linearising change of variables of Scherer, Gahinet and Chilali [SGC]_,
+   with an objective that keeps :math:`I - XY` well conditioned so the
+   controller has no needlessly fast poles.
+3. *Independent check*: the closed loop is rebuilt from ``P`` and ``K``,
+   its poles are computed, and its norm is recomputed by our Hamiltonian
+   algorithm (:func:`mutext.lti.hinf_norm`), by SLICOT's ``AB13DD`` (through
+   slycot) and on a frequency grid.
+
+Numerics: the plant's states are balanced by a diagonal similarity
+(powers of two) and the control and measurement channels normalised before
+the LMIs are formed; the two-mass plant of the thesis needs this (its
+optimal level is off by about 3 % without it).
+
+References
+----------
+.. [GA] P. Gahinet and P. Apkarian, "A linear matrix inequality approach to
+   H-infinity control", *Int. J. Robust Nonlinear Control* 4 (1994) 421-448.
+.. [SGC] C. Scherer, P. Gahinet and M. Chilali, "Multiobjective
+   output-feedback control via LMI optimization", *IEEE TAC* 42 (1997) 896-911.
+.. [ZDG] K. Zhou, J. C. Doyle and K. Glover, *Robust and Optimal Control*,
+   Prentice Hall, 1996, ch. 16-17.
+"""
+from __future__ import annotations
+
+import time
+import warnings
+from dataclasses import dataclass, field
+
+import control as ct
+import cvxpy as cp
+import numpy as np
+import scipy.linalg as sla
+
+from .errors import IllPosedError, InfeasibleError, ModelError, SolverError
+from .lti import as_ss, balance_states, check_finite, hinf_norm, lft_lower, sigma_max, ss
+
+__all__ = ["hinfsyn", "HinfResult", "check_plant", "PlantParts", "slycot_hinf_norm"]
+
+
+# ----------------------------------------------------------------------------
+# plant partition and assumptions
+# ----------------------------------------------------------------------------
+
+@dataclass
+class PlantParts:
+    """The blocks of a generalized plant (all 2-D float arrays)."""
+    A: np.ndarray
+    B1: np.ndarray
+    B2: np.ndarray
+    C1: np.ndarray
+    C2: np.ndarray
+    D11: np.ndarray
+    D12: np.ndarray
+    D21: np.ndarray
+    D22: np.ndarray
+
+    @property
+    def n(self):
+        return self.A.shape[0]
+
+    @property
+    def sizes(self):
+        """(n, nw, nu, nz, ny)."""
+        return self.A.shape[0], self.B1.shape[1], self.B2.shape[1], self.C1.shape[0], self.C2.shape[0]
+
+
+def _partition(P: ct.StateSpace, nmeas: int, ncon: int) -> PlantParts:
+    A, B, C, D = (np.asarray(X, float) for X in (P.A, P.B, P.C, P.D))
+    nw, nz = P.ninputs - ncon, P.noutputs - nmeas
+    return PlantParts(A, B[:, :nw], B[:, nw:], C[:nz], C[nz:],
+                      D[:nz, :nw], D[:nz, nw:], D[nz:, :nw], D[nz:, nw:])
+
+
+def _uncontrollable_modes(A, B, tol=1e-9):
+    """Eigenvalues of A in the closed right half plane that (A, B) cannot move (PBH test)."""
+    n = A.shape[0]
+    scale = max(1.0, np.linalg.norm(np.hstack([A, B]), 2))
+    bad = []
+    for lam in np.linalg.eigvals(A):
+        if lam.real < -1e-9 * max(1.0, abs(lam)):
+            continue
+        M = np.hstack([A - lam * np.eye(n), B])
+        smin = np.linalg.svd(M, compute_uv=False)[-1] if M.size else 0.0
+        if smin < tol * scale:
+            bad.append(lam)
+    return bad
+
+
+def check_plant(P, nmeas: int, ncon: int) -> tuple[ct.StateSpace, PlantParts, list[str]]:
+    """Validate a generalized plant for H-infinity synthesis.
+
+    Returns ``(P, parts, notes)`` where ``notes`` lists properties that are
+    allowed but worth knowing (singular ``D12``/``D21``).  Raises
+    :class:`ModelError` for malformed input (sizes, non-finite entries) and
+    :class:`IllPosedError` when no stabilizing controller can exist.
+    """
+    P = as_ss(P, "P")
+    check_finite(P, "P")
+    for name, v in (("nmeas", nmeas), ("ncon", ncon)):
+        if not isinstance(v, (int, np.integer)) or v < 1:
+            raise ModelError(f"{name} must be a positive integer, got {v!r}")
+    if ncon >= P.ninputs:
+        raise ModelError(f"ncon={ncon} but P has only {P.ninputs} inputs: "
+                         "at least one exogenous input w must remain")
+    if nmeas >= P.noutputs:
+        raise ModelError(f"nmeas={nmeas} but P has only {P.noutputs} outputs: "
+                         "at least one performance output z must remain")
+    parts = _partition(P, nmeas, ncon)
+    notes = []
+    if parts.n:
+        bad = _uncontrollable_modes(parts.A, parts.B2)
+        if bad:
+            raise IllPosedError(
+                "(A, B2) is not stabilizable: the mode(s) at s = "
+                + ", ".join(f"{b:.6g}" for b in bad)
+                + " are unstable (or on the imaginary axis) and cannot be moved by the control input u")
+        bad = _uncontrollable_modes(parts.A.T, parts.C2.T)
+        if bad:
+            raise IllPosedError(
+                "(C2, A) is not detectable: the mode(s) at s = "
+                + ", ".join(f"{b:.6g}" for b in bad)
+                + " are unstable (or on the imaginary axis) and invisible in the measurement y")
+    r12 = np.linalg.matrix_rank(parts.D12, tol=1e-12 * max(1.0, np.abs(parts.D12).max(initial=0)))
+    r21 = np.linalg.matrix_rank(parts.D21, tol=1e-12 * max(1.0, np.abs(parts.D21).max(initial=0)))
+    if r12 < ncon:
+        notes.append(f"D12 does not have full column rank (rank {r12} < ncon={ncon}): singular problem, "
+                     "outside the Riccati method's assumptions; solved by the LMI route. The optimal "
+                     "level may only be approached, with controller gains that grow as gamma nears it.")
+    if r21 < nmeas:
+        notes.append(f"D21 does not have full row rank (rank {r21} < nmeas={nmeas}): singular problem, "
+                     "outside the Riccati method's assumptions; solved by the LMI route. The optimal "
+                     "level may only be approached, with controller gains that grow as gamma nears it.")
+    return P, parts, notes
+
+
+# ----------------------------------------------------------------------------
+# scaling
+# ----------------------------------------------------------------------------
+
+def _scale(parts: PlantParts):
+    """Balance states, normalise u and y channels.  Returns (scaled parts, su, sy)
+    with u = diag(su) u_s and y_s = diag(sy) y."""
+    p = parts
+    n, nw, nu, nz, ny = p.sizes
+    B = np.hstack([p.B1, p.B2])
+    C = np.vstack([p.C1, p.C2])
+    D = np.block([[p.D11, p.D12], [p.D21, p.D22]])
+    bal, t = balance_states(ss(p.A, B, C, D)) if n else (ss(p.A, B, C, D), np.ones(0))
+    A, B, C = (np.asarray(X, float) for X in (bal.A, bal.B, bal.C))
+    B1, B2, C1, C2 = B[:, :nw], B[:, nw:], C[:nz], C[nz:]
+    cu = np.linalg.norm(np.vstack([B2, p.D12]), axis=0)
+    su = np.where(cu > 0, 1.0 / np.where(cu > 0, cu, 1.0), 1.0)
+    ry = np.linalg.norm(np.hstack([C2, p.D21]), axis=1)
+    sy = np.where(ry > 0, 1.0 / np.where(ry > 0, ry, 1.0), 1.0)
+    scaled = PlantParts(A, B1, B2 * su, C1, C2 * sy[:, None], p.D11, p.D12 * su,
+                        p.D21 * sy[:, None], (p.D22 * su) * sy[:, None])
+    return scaled, su, sy, t
+
+
+# ----------------------------------------------------------------------------
+# the LMIs
+# ----------------------------------------------------------------------------
+
+def _sym(E):
+    return 0.5 * (E + E.T)
+
+
+_TIGHT = {"max_iter": 400}
+_LOOSE = {"tol_gap_abs": 1e-6, "tol_gap_rel": 1e-6, "tol_feas": 1e-7, "max_iter": 400}
+
+
+def _solve(prob: cp.Problem, solver: str, what: str, gamma_hint=None, tight: bool = True):
+    opts = (_TIGHT if tight else _LOOSE) if solver.upper() == "CLARABEL" else {}
+    try:
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")
+            prob.solve(solver=solver, **opts)
+    except cp.error.SolverError as exc:
+        raise SolverError(f"{what}: solver {solver} failed ({exc})") from None
+    status = prob.status
+    if status in (cp.INFEASIBLE, cp.INFEASIBLE_INACCURATE):
+        at = f" at gamma={gamma_hint:.6g}" if gamma_hint is not None else ""
+        raise InfeasibleError(f"{what}: LMI infeasible{at} (solver status '{status}')")
+    if status not in (cp.OPTIMAL, cp.OPTIMAL_INACCURATE):
+        raise SolverError(f"{what}: solver {solver} returned status '{status}'")
+    return status
+
+
+def _optimal_level(p: PlantParts, solver: str, tight: bool = True):
+    """Gahinet-Apkarian LMIs: minimise gamma over (R, S)."""
+    n, nw, nu, nz, ny = p.sizes
+    R = cp.Variable((n, n), symmetric=True)
+    S = cp.Variable((n, n), symmetric=True)
+    g = cp.Variable()
+    NR = sla.null_space(np.hstack([p.B2.T, p.D12.T]))
+    NS = sla.null_space(np.hstack([p.C2, p.D21]))
+    Iw, Iz, In = np.eye(nw), np.eye(nz), np.eye(n)
+    M1 = cp.bmat([[p.A @ R + R @ p.A.T, R @ p.C1.T, p.B1],
+                  [p.C1 @ R, -g * Iz, p.D11],
+                  [p.B1.T, p.D11.T, -g * Iw]])
+    M2 = cp.bmat([[p.A.T @ S + S @ p.A, S @ p.B1, p.C1.T],
+                  [p.B1.T @ S, -g * Iw, p.D11.T],
+                  [p.C1, p.D11, -g * Iz]])
+    T1 = sla.block_diag(NR, Iw)
+    T2 = sla.block_diag(NS, Iz)
+    cons = [_sym(T1.T @ M1 @ T1) << 0, _sym(T2.T @ M2 @ T2) << 0,
+            cp.bmat([[R, In], [In, S]]) >> 0]
+    prob = cp.Problem(cp.Minimize(g), cons)
+    status = _solve(prob, solver, "H-infinity optimal level", tight=tight)
+    return float(g.value), R.value, S.value, status
+
+
+def _transform(p: PlantParts, T: np.ndarray, c: float = 1.0) -> PlantParts:
+    """The plant in state coordinates x = T x_new with w and z both scaled by
+    1/sqrt(c) (so the w -> z gain, and the optimal level, are divided by c;
+    the controller is unchanged and the LMI solutions R, S are invariant)."""
+    Ti = np.linalg.inv(T)
+    r = 1.0 / np.sqrt(c)
+    return PlantParts(Ti @ p.A @ T, r * (Ti @ p.B1), Ti @ p.B2, r * (p.C1 @ T), p.C2 @ T,
+                      p.D11 / c, r * p.D12, r * p.D21, p.D22)
+
+
+def _balancing_transform(R: np.ndarray, S: np.ndarray) -> np.ndarray | None:
+    """T with T^-1 R T^-T = T^T S T = diag(sigma): the coordinates in which the
+    two LMI solutions are equal and diagonal (like a balanced realization of
+    Gramians).  Returns None if R or S is not numerically positive definite."""
+    try:
+        Lr = np.linalg.cholesky(_sym(R))
+        Ls = np.linalg.cholesky(_sym(S))
+    except np.linalg.LinAlgError:
+        return None
+    _, sv, Vt = np.linalg.svd(Ls.T @ Lr)
+    if sv[-1] <= 0:
+        return None
+    return Lr @ Vt.T @ np.diag(sv ** -0.5)
+
+
+def _controller_at(p: PlantParts, gK: float, solver: str, bound: float = 1e4,
+                   objective: str = "margin"):
+    """Scherer-Gahinet-Chilali LMI at fixed level gK; returns (Ak, Bk, Ck, Dk, info).
+
+    Maximises t in [[Y, tI], [tI, X]] >= 0 with X, Y bounded, which keeps
+    I - XY away from singular (no needlessly fast controller poles).
+    """
+    n, nw, nu, nz, ny = p.sizes
+    X = cp.Variable((n, n), symmetric=True)
+    Y = cp.Variable((n, n), symmetric=True)
+    Ah = cp.Variable((n, n))
+    Bh = cp.Variable((n, ny))
+    Ch = cp.Variable((nu, n))
+    Dh = cp.Variable((nu, ny))
+    t = cp.Variable()
+    A, B1, B2, C1, C2, D11, D12, D21 = p.A, p.B1, p.B2, p.C1, p.C2, p.D11, p.D12, p.D21
+    L11 = A @ Y + B2 @ Ch
+    L11 = L11 + L11.T
+    L21 = Ah + (A + B2 @ Dh @ C2).T
+    L22 = X @ A + Bh @ C2
+    L22 = L22 + L22.T
+    L31 = (B1 + B2 @ Dh @ D21).T
+    L32 = (X @ B1 + Bh @ D21).T
+    L41 = C1 @ Y + D12 @ Ch
+    L42 = C1 + D12 @ Dh @ C2
+    L43 = D11 + D12 @ Dh @ D21
+    Iw, Iz, In = np.eye(nw), np.eye(nz), np.eye(n)
+    L = cp.bmat([[L11, L21.T, L31.T, L41.T],
+                 [L21, L22, L32.T, L42.T],
+                 [L31, L32, -gK * Iw, L43.T],
+                 [L41, L42, L43, -gK * Iz]])
+    # Chebyshev-centre-like point: the smallest margin of the two LMIs is
+    # maximised, so neither the closed-loop bounded-real inequality nor the
+    # coupling [[Y, I], [I, X]] > 0 sits on its boundary (either one tight makes
+    # the reconstructed controller fragile).  X, Y are bounded to fix the scale.
+    ntot = L.shape[0]
+    if objective == "margin":
+        cons = [_sym(L) << -t * np.eye(ntot),
+                cp.bmat([[Y, In], [In, X]]) >> t * np.eye(2 * n),
+                X << bound * In, Y << bound * In]
+    else:  # "coupling": keep I - XY far from singular, main LMI non-strict
+        cons = [_sym(L) << 0,
+                cp.bmat([[Y, t * In], [t * In, X]]) >> 0,
+                X << bound * In, Y << bound * In]
+    prob = cp.Problem(cp.Maximize(t), cons)
+    status = _solve(prob, solver, "H-infinity controller", gamma_hint=gK)
+    if t.value is None or (objective == "margin" and t.value <= 0):
+        raise InfeasibleError(f"H-infinity controller: no strictly feasible point at gamma={gK:.6g} "
+                              f"(margin {t.value})")
+    Xv, Yv = X.value, Y.value
+    Ahv, Bhv, Chv, Dhv = Ah.value, Bh.value, Ch.value, Dh.value
+    # U V^T = I - X Y, split by SVD so both factors are equally conditioned
+    Wl, sv, Wr = np.linalg.svd(In - Xv @ Yv)
+    if sv.size and sv[-1] <= 1e-14 * max(1.0, sv[0]):
+        raise SolverError(f"controller reconstruction failed at gamma={gK:.6g}: I - XY is singular")
+    U = Wl * np.sqrt(sv)
+    V = Wr.T * np.sqrt(sv)
+    Dk = Dhv
+    Ck = np.linalg.solve(V, (Chv - Dk @ C2 @ Yv).T).T
+    Bk = np.linalg.solve(U, Bhv - Xv @ B2 @ Dk)
+    inner = Ahv - Xv @ (A + B2 @ Dk @ C2) @ Yv - Xv @ B2 @ Ck @ V.T - U @ Bk @ C2 @ Yv
+    Ak = np.linalg.solve(V, np.linalg.solve(U, inner).T).T
+    info = {"t": float(t.value), "cond_I_minus_XY": float(sv[0] / sv[-1]) if sv.size else 1.0,
+            "status": status}
+    return Ak, Bk, Ck, Dk, info
+
+
+def _ric(H: np.ndarray):
+    """Stabilizing solution X of the Riccati equation with Hamiltonian H, or None
+    if H has imaginary-axis eigenvalues or its stable subspace is not a graph."""
+    n = H.shape[0] // 2
+    if not np.all(np.isfinite(H)):
+        return None
+    T, Z, sdim = sla.schur(H, output="real", sort="lhp")
+    ev = np.linalg.eigvals(H)
+    if np.any(np.abs(ev.real) < 1e-10 * max(1.0, np.abs(ev).max())) or sdim != n:
+        return None
+    U1, U2 = Z[:n, :n], Z[n:, :n]
+    if np.linalg.cond(U1) > 1e13:
+        return None
+    X = np.linalg.solve(U1.T, U2.T).T
+    return _sym(X)
+
+
+def riccati_feasible(p: PlantParts, g: float) -> bool:
+    r"""Exact test of whether a controller with closed-loop norm < g exists, for
+    regular problems (``D12`` full column rank, ``D21`` full row rank).
+
+    The conditions of Zhou, Doyle and Glover, *Robust and Optimal Control*,
+    Theorem 17.1 (general case, no normalisation of ``D12``, ``D21``): with
+    :math:`R = D_{1\bullet}^TD_{1\bullet} - \mathrm{diag}(g^2I, 0)`,
+    :math:`\tilde R = D_{\bullet1}D_{\bullet1}^T - \mathrm{diag}(g^2I, 0)`,
+    (i) ``g`` exceeds the gain of the parts of ``D11`` that neither ``u`` nor
+    ``y`` can reach; (ii) the Hamiltonian :math:`H_\infty` has a stabilizing
+    Riccati solution :math:`X_\infty \succeq 0`; (iii) likewise
+    :math:`Y_\infty \succeq 0` for :math:`J_\infty`; (iv)
+    :math:`\rho(X_\infty Y_\infty) < g^2`.
+    """
+    n, nw, nu, nz, ny = p.sizes
+    A, B1, B2, C1, C2, D11, D12, D21 = p.A, p.B1, p.B2, p.C1, p.C2, p.D11, p.D12, p.D21
+    P12 = D12 @ np.linalg.pinv(D12)
+    P21 = np.linalg.pinv(D21) @ D21
+    if np.linalg.norm((np.eye(nz) - P12) @ D11, 2) >= g or np.linalg.norm(D11 @ (np.eye(nw) - P21), 2) >= g:
+        return False
+    B = np.hstack([B1, B2])
+    D1 = np.hstack([D11, D12])
+    R = D1.T @ D1 - sla.block_diag(g * g * np.eye(nw), np.zeros((nu, nu)))
+    Hx = (np.block([[A, np.zeros((n, n))], [-C1.T @ C1, -A.T]])
+          - np.vstack([B, -C1.T @ D1]) @ np.linalg.solve(R, np.hstack([D1.T @ C1, B.T])))
+    X = _ric(Hx)
+    if X is None:
+        return False
+    C = np.vstack([C1, C2])
+    Dc = np.vstack([D11, D21])
+    Rt = Dc @ Dc.T - sla.block_diag(g * g * np.eye(nz), np.zeros((ny, ny)))
+    Jy = (np.block([[A.T, np.zeros((n, n))], [-B1 @ B1.T, -A]])
+          - np.vstack([C.T, -B1 @ Dc.T]) @ np.linalg.solve(Rt, np.hstack([Dc @ B1.T, C])))
+    Y = _ric(Jy)
+    if Y is None:
+        return False
+    tol = 1e-10
+    if np.linalg.eigvalsh(X).min() < -tol * max(1.0, np.abs(X).max()):
+        return False
+    if np.linalg.eigvalsh(Y).min() < -tol * max(1.0, np.abs(Y).max()):
+        return False
+    return float(np.max(np.abs(np.linalg.eigvals(X @ Y)))) < g * g
+
+
+def _refine_level(p: PlantParts, g_lmi: float, rtol: float = 1e-10):
+    """Bisection on :func:`riccati_feasible` around the LMI level.  Returns the
+    refined level, or None if the test does not bracket the LMI level."""
+    hi = g_lmi * (1 + 1e-3)
+    for _ in range(8):
+        if riccati_feasible(p, hi):
+            break
+        hi *= 1.5
+    else:
+        return None
+    lo = g_lmi * (1 - 1e-2)
+    for _ in range(8):
+        if not riccati_feasible(p, lo):
+            break
+        lo *= 0.5
+    else:
+        return None
+    while hi - lo > rtol * hi:
+        mid = 0.5 * (lo + hi)
+        if riccati_feasible(p, mid):
+            hi = mid
+        else:
+            lo = mid
+    return hi
+
+
+def _add_d22(Ak, Bk, Ck, Dk, D22):
+    """Controller for the plant with feedthrough D22 from K0 designed with D22 = 0:
+    K = K0 (I + D22 K0)^{-1}."""
+    if not np.any(D22):
+        return Ak, Bk, Ck, Dk
+    E = np.eye(Dk.shape[0]) + Dk @ D22
+    if np.linalg.cond(E) > 1e12:
+        raise IllPosedError("I + DK*D22 is singular: the controller loop is not well posed with this D22")
+    Z = np.linalg.inv(E)
+    return (Ak - Bk @ D22 @ Z @ Ck, Bk @ (np.eye(D22.shape[0]) - D22 @ Z @ Dk), Z @ Ck, Z @ Dk)
+
+
+# ----------------------------------------------------------------------------
+# verification
+# ----------------------------------------------------------------------------
+
+def slycot_hinf_norm(sys) -> float:
+    """H-infinity norm by SLICOT AB13DD (through slycot), used as an independent check.
+
+    Returns ``nan`` when slycot is not available or fails.
+    """
+    sys = as_ss(sys)
+    try:
+        from slycot import ab13dd
+    except ImportError:  # pragma: no cover - slycot is a dependency
+        return float("nan")
+    n, m, p = sys.nstates, sys.ninputs, sys.noutputs
+    if n == 0:
+        return float(np.linalg.norm(np.asarray(sys.D, float), 2))
+    try:
+        gpeak, _ = ab13dd('C', 'I', 'N', 'D', n, m, p, np.asarray(sys.A, float), np.eye(n),
+                          np.asarray(sys.B, float), np.asarray(sys.C, float),
+                          np.asarray(sys.D, float))
+    except Exception:  # slycot raises several error types; the check is advisory
+        return float("nan")
+    return float(gpeak)
+
+
+@dataclass
+class HinfResult:
+    r"""Result of :func:`hinfsyn`.
+
+    Attributes
+    ----------
+    K : control.StateSpace
+        The controller (``ncon`` outputs, ``nmeas`` inputs).
+    CL : control.StateSpace
+        The closed loop :math:`\mathcal F_\ell(P, K)` rebuilt from ``P`` and ``K``.
+    gamma : float
+        Optimal level from the LMIs: the infimum of the closed-loop norm over
+        all stabilizing controllers (to solver accuracy).
+    gamma_target : float
+        The level at which the controller was constructed (``gamma`` times
+        ``1 + backoff``).
+    closed_loop_norm : float
+        :math:`\|\mathcal F_\ell(P, K)\|_\infty` recomputed by our Hamiltonian algorithm.
+    closed_loop_norm_slycot : float
+        The same norm by SLICOT AB13DD (``nan`` if unavailable).
+    closed_loop_norm_grid : float
+        Peak of the largest singular value on a log-spaced frequency grid (a lower bound).
+    peak_frequency : float
+        Frequency (rad/s) of the closed-loop peak.
+    stable : bool
+        All closed-loop poles in the open left half plane.
+    controller_poles : ndarray
+    notes : list of str
+        Properties of the problem worth knowing (singular D12/D21, D22 handling, ...).
+    """
+    K: ct.StateSpace
+    CL: ct.StateSpace
+    gamma: float
+    gamma_target: float
+    closed_loop_norm: float
+    closed_loop_norm_slycot: float
+    closed_loop_norm_grid: float
+    peak_frequency: float
+    stable: bool
+    max_closed_loop_real_part: float
+    controller_poles: np.ndarray
+    backoff: float
+    notes: list = field(default_factory=list)
+    solver: str = "CLARABEL"
+    seconds: float = 0.0
+    info: dict = field(default_factory=dict)
+
+    @property
+    def controller_order(self) -> int:
+        return self.K.nstates
+
+    @property
+    def controller_rhp_poles(self) -> np.ndarray:
+        return self.controller_poles[self.controller_poles.real > 0]
+
+    def summary(self) -> str:
+        """A short human-readable report."""
+        lines = [
+            f"optimal level (LMI)       gamma = {self.gamma:.6f}",
+            f"controller built at       gamma = {self.gamma_target:.6f} (backoff {self.backoff:g})",
+            f"closed-loop norm (ours)         = {self.closed_loop_norm:.6f} at {self.peak_frequency:.4g} rad/s",
+            f"closed-loop norm (slycot AB13DD)= {self.closed_loop_norm_slycot:.6f}",
+            f"closed loop stable              = {self.stable} (max real part {self.max_closed_loop_real_part:.3g})",
+            f"controller order                = {self.controller_order}, "
+            f"right-half-plane poles: {len(self.controller_rhp_poles)}",
+        ]
+        lines += [f"note: {n}" for n in self.notes]
+        return "\n".join(lines)
+
+
+def _verify(P, K, nmeas, ncon):
+    CL = lft_lower(P, K, nmeas, ncon)
+    poles = np.linalg.eigvals(np.asarray(CL.A, float)) if CL.nstates else np.zeros(0)
+    maxre = float(poles.real.max()) if poles.size else -np.inf
+    stable = bool(maxre < 0)
+    if stable:
+        nrm = hinf_norm(CL)
+        value, wpk = nrm.value, nrm.frequency
+    else:
+        value, wpk = np.inf, np.nan
+    sly = slycot_hinf_norm(CL) if stable else np.inf
+    # grid: log-spaced around the pole magnitudes, plus the peak found
+    if CL.nstates:
+        mags = np.abs(poles[np.abs(poles) > 0]) if poles.size else np.array([1.0])
+        lo, hi = (mags.min() / 100, mags.max() * 100) if mags.size else (1e-3, 1e3)
+    else:
+        lo, hi = 1e-3, 1e3
+    grid = np.logspace(np.log10(lo), np.log10(hi), 400)
+    if np.isfinite(wpk) and wpk > 0:
+        grid = np.sort(np.append(grid, wpk))
+    gpk = float(sigma_max(CL, grid).max()) if stable else np.inf
+    gpk = max(gpk, float(np.linalg.norm(np.asarray(CL.D, float), 2)) if CL.D.size else 0.0)
+    return CL, stable, maxre, value, wpk, sly, gpk
+
+
+# ----------------------------------------------------------------------------
+# main entry point
+# ----------------------------------------------------------------------------
+
+def hinfsyn(P, nmeas: int, ncon: int, *, solver: str = "CLARABEL", backoff: float = 1e-4,
+            scale: bool = True, max_backoff: float = 0.05, refine: bool = True,
+            controller_objective: str = "margin") -> HinfResult:
+    r"""H-infinity synthesis by LMIs (same argument order as :func:`control.hinfsyn`).
+
+    Parameters
+    ----------
+    P : control.StateSpace
+        Generalized plant with inputs ``[w; u]`` and outputs ``[z; y]``
+        (continuous time).
+    nmeas : int
+        Number of measurements ``y`` (the last outputs of ``P``).
+    ncon : int
+        Number of control inputs ``u`` (the last inputs of ``P``).
+    solver : str
+        cvxpy solver name (default Clarabel).
+    backoff : float
+        The controller is built at level ``gamma * (1 + backoff)``; a strictly
+        suboptimal level keeps it well conditioned.  If the check of the
+        closed loop fails, the backoff is raised tenfold up to ``max_backoff``.
+    scale : bool
+        Balance the plant's states and normalise ``u``, ``y`` first (recommended).
+
+    Returns
+    -------
+    HinfResult
+        Controller ``K``, closed loop ``CL``, optimal level ``gamma`` and the
+        independently recomputed closed-loop norm.
+
+    Raises
+    ------
+    ModelError
+        Wrong port counts, non-finite entries, discrete-time plant.
+    IllPosedError
+        ``(A, B2)`` not stabilizable or ``(C2, A)`` not detectable.
+    InfeasibleError, SolverError
+        The LMIs could not be solved, or no controller passing the check was found.
+
+    Examples
+    --------
+    >>> from mutext.examples import two_mass
+    >>> res = hinfsyn(two_mass.plant(), 1, 1)
+    >>> round(res.gamma, 4)
+    1.0069
+    """
+    t0 = time.perf_counter()
+    P, parts, notes = check_plant(P, nmeas, ncon)
+    if parts.n == 0:
+        raise ModelError("P has no states: static H-infinity synthesis is not supported")
+    work, su, sy, tstate = _scale(parts) if scale else (parts, np.ones(ncon), np.ones(nmeas), np.ones(parts.n))
+    D22 = work.D22
+    work0 = PlantParts(work.A, work.B1, work.B2, work.C1, work.C2, work.D11, work.D12, work.D21,
+                       np.zeros_like(D22))
+    # Pass 0 (loose tolerance) locates the level; later passes re-solve in the
+    # state coordinates that balance its solution (R, S) and with w, z scaled so
+    # that the level is near 1.  Plant-based balancing alone leaves R and S
+    # spread over decades and gamma arbitrary, which costs the solver digits.
+    try:
+        g0, R, S, st1 = _optimal_level(work0, solver, tight=False)
+    except SolverError:
+        g0, R, S, st1 = _optimal_level(work0, solver, tight=True)
+    gscale = 1.0   # true level = gscale * level of the current working plant
+    gamma = g0
+    levels = [g0]
+    for _ in range(3):
+        T = _balancing_transform(R, S)
+        if T is None or not np.all(np.isfinite(T)):
+            T = np.eye(parts.n)
+        c = gamma / gscale  # current working-plant level, to be normalised to ~1
+        trial = _transform(work0, T, c)
+        try:
+            g2, R2, S2, st2 = _optimal_level(trial, solver, tight=True)
+        except (InfeasibleError, SolverError):
+            break
+        if st2 != cp.OPTIMAL:
+            break
+        work0, R, S, st1 = trial, R2, S2, st2
+        gscale *= c
+        g2 *= gscale
+        levels.append(g2)
+        converged = abs(g2 - gamma) <= 1e-9 * gamma
+        gamma = g2
+        if converged:
+            break
+    if len(levels) == 1 and st1 != cp.OPTIMAL:
+        raise SolverError(f"H-infinity optimal level: solver {solver} reached only status '{st1}' "
+                          f"(gamma about {gamma:.6g}); the plant may be too badly conditioned")
+    if not np.isfinite(gamma) or gamma <= 0:
+        raise SolverError(f"H-infinity optimal level: solver returned gamma={gamma}")
+    gamma_lmi = gamma
+    level_method = "LMI"
+    regular = not any(n.startswith(("D12 does not", "D21 does not")) for n in notes)
+    if regular and refine:
+        g_ref = _refine_level(work0, gamma / gscale)
+        if g_ref is not None and abs(g_ref * gscale - gamma) <= 1e-2 * gamma:
+            gamma = g_ref * gscale
+            level_method = "LMI, refined by bisection on the Riccati conditions"
+    bound = 10.0 * max(np.linalg.eigvalsh(_sym(R)).max(), np.linalg.eigvalsh(_sym(S)).max(), 1.0)
+    if np.any(D22):
+        notes.append("D22 is nonzero: controller designed for D22 = 0 and corrected by K = K0 (I + D22 K0)^-1")
+    tries = []
+    b = backoff
+    best = None
+    while True:
+        gK = gamma * (1.0 + b)
+        try:
+            Ak, Bk, Ck, Dk, info = _controller_at(work0, gK / gscale, solver, bound,
+                                                  objective=controller_objective)
+            Ak, Bk, Ck, Dk = _add_d22(Ak, Bk, Ck, Dk, D22)
+            # undo the u/y normalisation: u = su * K_s(sy * y)
+            Ks = ss(Ak, Bk * sy[None, :], su[:, None] * Ck, su[:, None] * Dk * sy[None, :])
+            K = ss(Ks.A, Ks.B, Ks.C, Ks.D, inputs=P.output_labels[-nmeas:],
+                   outputs=P.input_labels[-ncon:], name="K")
+            CL, stable, maxre, value, wpk, sly, gpk = _verify(P, K, nmeas, ncon)
+            ok = stable and value <= gK * (1 + 1e-6)
+            tries.append({"backoff": b, "gamma_target": gK, "stable": stable, "closed_loop_norm": value,
+                          **info})
+            cand = (K, CL, stable, maxre, value, wpk, sly, gpk, gK, b)
+            if best is None or (stable and (not best[2] or value < best[4])):
+                best = cand
+            if ok:
+                break
+        except (InfeasibleError, SolverError) as exc:
+            tries.append({"backoff": b, "gamma_target": gK, "error": str(exc)})
+        if b * 10 > max_backoff + 1e-15:
+            break
+        b *= 10
+    if best is None or not best[2]:
+        raise SolverError("H-infinity synthesis: no stabilizing controller passed the check "
+                          f"(optimal level gamma={gamma:.6g}); attempts: {tries}")
+    K, CL, stable, maxre, value, wpk, sly, gpk, gK, b = best
+    if value > gK * (1 + 1e-6):
+        notes.append(f"the best controller found achieves {value:.6g}, above the target level {gK:.6g}")
+    poles = np.linalg.eigvals(np.asarray(K.A, float)) if K.nstates else np.zeros(0)
+    return HinfResult(K=K, CL=CL, gamma=gamma, gamma_target=gK, closed_loop_norm=value,
+                      closed_loop_norm_slycot=sly, closed_loop_norm_grid=gpk, peak_frequency=wpk,
+                      stable=stable, max_closed_loop_real_part=maxre, controller_poles=poles,
+                      backoff=b, notes=notes, solver=solver, seconds=time.perf_counter() - t0,
+                      info={"tries": tries, "level_status": st1, "levels": levels, "gamma_lmi": gamma_lmi,
+                            "level_method": level_method, "state_scaling": tstate,
+                            "u_scaling": su, "y_scaling": sy})
