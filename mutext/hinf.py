@@ -66,9 +66,10 @@ import numpy as np
 import scipy.linalg as sla
 
 from .errors import IllPosedError, InfeasibleError, ModelError, SolverError
-from .lti import as_ss, balance_states, check_finite, hinf_norm, lft_lower, sigma_max, ss
+from .lti import as_ss, balance_states, check_finite, hinf_norm, is_stable, lft_lower, sigma_max, ss
 
-__all__ = ["hinfsyn", "HinfResult", "check_plant", "PlantParts", "slycot_hinf_norm"]
+__all__ = ["hinfsyn", "HinfResult", "check_plant", "PlantParts", "slycot_hinf_norm", "slycot_hinfsyn",
+           "SlycotReference"]
 
 
 # ----------------------------------------------------------------------------
@@ -270,7 +271,7 @@ def _balancing_transform(R: np.ndarray, S: np.ndarray) -> np.ndarray | None:
 
 
 def _controller_at(p: PlantParts, gK: float, solver: str, bound: float = 1e4,
-                   objective: str = "margin"):
+                   objective: str = "margin", gscale: float = 1.0):
     """Scherer-Gahinet-Chilali LMI at fixed level gK; returns (Ak, Bk, Ck, Dk, info).
 
     Maximises t in [[Y, tI], [tI, X]] >= 0 with X, Y bounded, which keeps
@@ -314,16 +315,16 @@ def _controller_at(p: PlantParts, gK: float, solver: str, bound: float = 1e4,
                 cp.bmat([[Y, t * In], [t * In, X]]) >> 0,
                 X << bound * In, Y << bound * In]
     prob = cp.Problem(cp.Maximize(t), cons)
-    status = _solve(prob, solver, "H-infinity controller", gamma_hint=gK)
+    status = _solve(prob, solver, "H-infinity controller", gamma_hint=gK * gscale)
     if t.value is None or (objective == "margin" and t.value <= 0):
-        raise InfeasibleError(f"H-infinity controller: no strictly feasible point at gamma={gK:.6g} "
+        raise InfeasibleError(f"H-infinity controller: no strictly feasible point at gamma={gK * gscale:.6g} "
                               f"(margin {t.value})")
     Xv, Yv = X.value, Y.value
     Ahv, Bhv, Chv, Dhv = Ah.value, Bh.value, Ch.value, Dh.value
     # U V^T = I - X Y, split by SVD so both factors are equally conditioned
     Wl, sv, Wr = np.linalg.svd(In - Xv @ Yv)
     if sv.size and sv[-1] <= 1e-14 * max(1.0, sv[0]):
-        raise SolverError(f"controller reconstruction failed at gamma={gK:.6g}: I - XY is singular")
+        raise SolverError(f"controller reconstruction failed at gamma={gK * gscale:.6g}: I - XY is singular")
     U = Wl * np.sqrt(sv)
     V = Wr.T * np.sqrt(sv)
     Dk = Dhv
@@ -462,6 +463,82 @@ def slycot_hinf_norm(sys) -> float:
 
 
 @dataclass
+class SlycotReference:
+    """What slycot's Riccati ``hinfsyn`` returned for a plant, and whether it holds up.
+
+    ``status`` is ``'verified'`` (its controller stabilises the rebuilt closed
+    loop and achieves the claimed level to ``rtol``), ``'unverified'`` (it
+    returned, but the claim does not hold: see ``note``), ``'error'`` (it
+    refused the problem) or ``'timeout'``.
+    """
+    status: str
+    gamma: float = float("nan")
+    K: ct.StateSpace | None = None
+    achieved: float = float("nan")
+    note: str = ""
+    seconds: float = 0.0
+
+
+def _slycot_child(P, nmeas, ncon, conn):
+    try:
+        t0 = time.perf_counter()
+        K, _, gam, _ = ct.hinfsyn(P, nmeas, ncon)
+        conn.send(("ok", float(gam), (K.A, K.B, K.C, K.D), time.perf_counter() - t0))
+    except Exception as exc:  # slycot raises several error types; each is a result to report
+        conn.send(("error", f"{type(exc).__name__}: {str(exc).splitlines()[0][:80] if str(exc) else ''}",
+                   None, 0.0))
+    conn.close()
+
+
+def slycot_hinfsyn(P, nmeas: int, ncon: int, timeout: float | None = 20.0,
+                   rtol: float = 1e-3) -> SlycotReference:
+    """Run python-control/slycot's ``hinfsyn`` as an independent reference, and check its claim.
+
+    slycot (SB10AD) can take very long or never return on badly scaled or
+    singular plants, so with ``timeout`` set it runs in a forked child process
+    that is killed after ``timeout`` seconds.  Its controller is then checked
+    the same way ours is: closed loop rebuilt from ``P`` and ``K``, stability,
+    norm recomputed by :func:`mutext.lti.hinf_norm`.
+    """
+    import multiprocessing as mp
+    P = as_ss(P, "P")
+    t0 = time.perf_counter()
+    if timeout is None:
+        parent, child = mp.Pipe(duplex=False)
+        _slycot_child(P, nmeas, ncon, child)
+        msg = parent.recv()
+    else:
+        parent, child = mp.Pipe(duplex=False)
+        proc = mp.get_context("fork").Process(target=_slycot_child, args=(P, nmeas, ncon, child))
+        with warnings.catch_warnings():  # fork from a threaded process: the child only runs slycot
+            warnings.simplefilter("ignore", DeprecationWarning)
+            proc.start()
+        child.close()
+        if not parent.poll(timeout):
+            proc.kill()
+            proc.join()
+            return SlycotReference("timeout", note=f"no answer within {timeout:g} s",
+                                   seconds=time.perf_counter() - t0)
+        try:
+            msg = parent.recv()
+        except EOFError:
+            msg = ("error", f"slycot process died (exit code {proc.exitcode})", None, 0.0)
+        proc.join()
+    status, gam, mats, sec = msg
+    if status == "error":
+        return SlycotReference("error", note=gam, seconds=sec)
+    K = ss(*mats)
+    CL = lft_lower(P, K, nmeas, ncon)
+    if not is_stable(CL):
+        return SlycotReference("unverified", gam, K, np.inf, "its closed loop is unstable", sec)
+    achieved = hinf_norm(CL).value
+    if abs(achieved - gam) > rtol * gam:
+        return SlycotReference("unverified", gam, K, achieved,
+                               f"claims {gam:.7g}, its controller achieves {achieved:.7g}", sec)
+    return SlycotReference("verified", gam, K, achieved, "", sec)
+
+
+@dataclass
 class HinfResult:
     r"""Result of :func:`hinfsyn`.
 
@@ -556,13 +633,126 @@ def _verify(P, K, nmeas, ncon):
     return CL, stable, maxre, value, wpk, sly, gpk
 
 
+
+@dataclass
+class _Level:
+    """Optimal level and the working coordinates it was computed in."""
+    work: PlantParts       # scaled plant with D22 = 0 (level = gamma / gscale)
+    D22: np.ndarray        # D22 of the scaled plant
+    gscale: float
+    gamma: float           # true optimal level
+    gamma_lmi: float
+    R: np.ndarray
+    S: np.ndarray
+    status: str
+    levels: list
+    method: str
+    su: np.ndarray
+    sy: np.ndarray
+    tstate: np.ndarray
+    alpha: float = 1.0  # time scaling, P_work(s) = P(alpha s)
+
+
+def _time_scale(p: PlantParts, alpha: float) -> PlantParts:
+    """The plant with frequency axis rescaled, P'(s) = P(alpha s); the H-infinity
+    level is unchanged and a controller K' for P' gives K(s) = K'(s / alpha)."""
+    r = 1.0 / np.sqrt(alpha)
+    return PlantParts(p.A / alpha, r * p.B1, r * p.B2, r * p.C1, r * p.C2, p.D11, p.D12, p.D21, p.D22)
+
+
+def _level(parts: PlantParts, notes: list, solver: str, scale: bool, refine: bool) -> _Level:
+    nmeas, ncon = parts.C2.shape[0], parts.B2.shape[1]
+    work, su, sy, tstate = _scale(parts) if scale else (parts, np.ones(ncon), np.ones(nmeas), np.ones(parts.n))
+    alpha = 1.0
+    if scale:
+        # frequencies of order one: the LMI entries A R + R A^T and the gamma
+        # blocks are then of comparable size
+        mags = np.abs(np.linalg.eigvals(work.A))
+        if mags.max() > 0:
+            alpha = float(2.0 ** np.round(np.log2(mags.max())))
+            work = _time_scale(work, alpha)
+    D22 = work.D22
+    work0 = PlantParts(work.A, work.B1, work.B2, work.C1, work.C2, work.D11, work.D12, work.D21,
+                       np.zeros_like(D22))
+    # Pass 0 locates the level.  If the solver gives up, retry with w and z
+    # scaled down (large levels make the gamma blocks dominate the LMIs).
+    gscale, first, errors = 1.0, None, []
+    for c in (1.0, 1e3, 1e6):
+        trial = _transform(work0, np.eye(parts.n), c) if c != 1.0 else work0
+        for tight in (False, True):
+            try:
+                first = _optimal_level(trial, solver, tight=tight)
+                break
+            except SolverError as exc:
+                errors.append(str(exc))
+            except InfeasibleError as exc:
+                errors.append(str(exc))
+                break
+        if first is not None:
+            work0, gscale = trial, c
+            break
+    if first is None:
+        raise SolverError("H-infinity optimal level: the LMI solver failed on the scaled plant "
+                          f"(tried w, z scalings 1, 1e3, 1e6); last error: {errors[-1]}")
+    g0, R, S, st1 = first
+    # Later passes re-solve in the state coordinates that balance the previous
+    # solution (R, S) and with w, z scaled so that the level is near 1.
+    # Plant-based balancing alone leaves R and S spread over decades, which
+    # costs the solver digits.  A pass that raises the level is discarded.
+    gamma = g0 * gscale
+    levels = [gamma]
+    best = (gamma, work0, gscale, R, S, st1)
+    for _ in range(3):
+        T = _balancing_transform(R, S)
+        if T is None or not np.all(np.isfinite(T)):
+            T = np.eye(parts.n)
+        c = gamma / gscale
+        trial = _transform(work0, T, c)
+        try:
+            g2, R2, S2, st2 = _optimal_level(trial, solver, tight=True)
+        except (InfeasibleError, SolverError):
+            break
+        g2 *= gscale * c
+        levels.append(g2)
+        if st2 != cp.OPTIMAL:
+            break
+        work0, R, S, st1, gscale = trial, R2, S2, st2, gscale * c
+        converged = abs(g2 - gamma) <= 1e-9 * gamma
+        if g2 > best[0] * (1 + 1e-7):
+            break
+        gamma = g2
+        best = (gamma, work0, gscale, R, S, st1)
+        if converged:
+            break
+    gamma, work0, gscale, R, S, st1 = best
+    if not np.isfinite(gamma) or gamma <= 0:
+        raise SolverError(f"H-infinity optimal level: solver returned gamma={gamma}")
+    gamma_lmi = gamma
+    level_method = "LMI"
+    if st1 != cp.OPTIMAL:
+        level_method = f"LMI (solver status {st1})"
+    regular = not any(n.startswith(("D12 does not", "D21 does not")) for n in notes)
+    if regular and refine:
+        g_ref = _refine_level(work0, gamma / gscale)
+        if g_ref is not None and g_ref * gscale <= gamma * (1 + 1e-3):
+            gamma = g_ref * gscale
+            level_method += ", refined by bisection on the Riccati conditions"
+            if gamma < gamma_lmi * (1 - 1e-4):
+                notes.append(f"the LMI solver's level {gamma_lmi:.6g} was inaccurate; the Riccati "
+                             f"conditions (ZDG Thm 17.1) place the optimum at {gamma:.6g}")
+    return _Level(work0, D22, gscale, gamma, gamma_lmi, R, S, st1, levels, level_method, su, sy,
+                  tstate, alpha)
+
 # ----------------------------------------------------------------------------
 # main entry point
 # ----------------------------------------------------------------------------
 
+_BACKOFFS = (1e-4, 3e-4, 1e-3, 3e-3, 1e-2, 3e-2)
+
+
 def hinfsyn(P, nmeas: int, ncon: int, *, solver: str = "CLARABEL", backoff: float = 1e-4,
-            scale: bool = True, max_backoff: float = 0.05, refine: bool = True,
-            controller_objective: str = "margin") -> HinfResult:
+            scale: bool = True, max_backoff: float = 0.03, refine: bool = True,
+            controller_objective: str = "coupling", bound_factor: float = 1e3) -> HinfResult:
     r"""H-infinity synthesis by LMIs (same argument order as :func:`control.hinfsyn`).
 
     Parameters
@@ -578,10 +768,24 @@ def hinfsyn(P, nmeas: int, ncon: int, *, solver: str = "CLARABEL", backoff: floa
         cvxpy solver name (default Clarabel).
     backoff : float
         The controller is built at level ``gamma * (1 + backoff)``; a strictly
-        suboptimal level keeps it well conditioned.  If the check of the
-        closed loop fails, the backoff is raised tenfold up to ``max_backoff``.
+        suboptimal level keeps it well conditioned.  If the closed loop fails
+        the check (unstable, or norm above the target level), the backoff is
+        raised step by step (1e-4, 3e-4, 1e-3, ...) up to ``max_backoff``.
     scale : bool
-        Balance the plant's states and normalise ``u``, ``y`` first (recommended).
+        Balance the plant's states, rescale time and normalise ``u``, ``y``
+        first (recommended).
+    refine : bool
+        For regular problems (``D12`` full column rank, ``D21`` full row rank),
+        refine the LMI level by bisection on the exact Riccati existence
+        conditions (:func:`riccati_feasible`).
+    controller_objective : {"coupling", "margin"}
+        How a point inside the controller LMI is chosen: "coupling" keeps
+        ``I - XY`` far from singular (fewer needlessly fast controller poles);
+        "margin" maximises a uniform margin of both LMIs.  The other one is
+        tried if the first yields no stabilizing controller.
+    bound_factor : float
+        ``X`` and ``Y`` of the controller LMI are bounded by this factor times
+        the largest eigenvalue of the level LMI solution.
 
     Returns
     -------
@@ -609,87 +813,54 @@ def hinfsyn(P, nmeas: int, ncon: int, *, solver: str = "CLARABEL", backoff: floa
     P, parts, notes = check_plant(P, nmeas, ncon)
     if parts.n == 0:
         raise ModelError("P has no states: static H-infinity synthesis is not supported")
-    work, su, sy, tstate = _scale(parts) if scale else (parts, np.ones(ncon), np.ones(nmeas), np.ones(parts.n))
-    D22 = work.D22
-    work0 = PlantParts(work.A, work.B1, work.B2, work.C1, work.C2, work.D11, work.D12, work.D21,
-                       np.zeros_like(D22))
-    # Pass 0 (loose tolerance) locates the level; later passes re-solve in the
-    # state coordinates that balance its solution (R, S) and with w, z scaled so
-    # that the level is near 1.  Plant-based balancing alone leaves R and S
-    # spread over decades and gamma arbitrary, which costs the solver digits.
-    try:
-        g0, R, S, st1 = _optimal_level(work0, solver, tight=False)
-    except SolverError:
-        g0, R, S, st1 = _optimal_level(work0, solver, tight=True)
-    gscale = 1.0   # true level = gscale * level of the current working plant
-    gamma = g0
-    levels = [g0]
-    for _ in range(3):
-        T = _balancing_transform(R, S)
-        if T is None or not np.all(np.isfinite(T)):
-            T = np.eye(parts.n)
-        c = gamma / gscale  # current working-plant level, to be normalised to ~1
-        trial = _transform(work0, T, c)
-        try:
-            g2, R2, S2, st2 = _optimal_level(trial, solver, tight=True)
-        except (InfeasibleError, SolverError):
-            break
-        if st2 != cp.OPTIMAL:
-            break
-        work0, R, S, st1 = trial, R2, S2, st2
-        gscale *= c
-        g2 *= gscale
-        levels.append(g2)
-        converged = abs(g2 - gamma) <= 1e-9 * gamma
-        gamma = g2
-        if converged:
-            break
-    if len(levels) == 1 and st1 != cp.OPTIMAL:
-        raise SolverError(f"H-infinity optimal level: solver {solver} reached only status '{st1}' "
-                          f"(gamma about {gamma:.6g}); the plant may be too badly conditioned")
-    if not np.isfinite(gamma) or gamma <= 0:
-        raise SolverError(f"H-infinity optimal level: solver returned gamma={gamma}")
-    gamma_lmi = gamma
-    level_method = "LMI"
-    regular = not any(n.startswith(("D12 does not", "D21 does not")) for n in notes)
-    if regular and refine:
-        g_ref = _refine_level(work0, gamma / gscale)
-        if g_ref is not None and abs(g_ref * gscale - gamma) <= 1e-2 * gamma:
-            gamma = g_ref * gscale
-            level_method = "LMI, refined by bisection on the Riccati conditions"
-    bound = 10.0 * max(np.linalg.eigvalsh(_sym(R)).max(), np.linalg.eigvalsh(_sym(S)).max(), 1.0)
+    lev = _level(parts, notes, solver, scale, refine)
+    work0, D22, gscale, gamma, R, S = lev.work, lev.D22, lev.gscale, lev.gamma, lev.R, lev.S
+    su, sy = lev.su, lev.sy
+    bound = bound_factor * max(np.linalg.eigvalsh(_sym(R)).max(), np.linalg.eigvalsh(_sym(S)).max(), 1.0)
     if np.any(D22):
         notes.append("D22 is nonzero: controller designed for D22 = 0 and corrected by K = K0 (I + D22 K0)^-1")
+    schedule = [x for x in _BACKOFFS if backoff <= x <= max_backoff] or [backoff]
+    # At each level, try the preferred controller LMI objective first, then the
+    # other one, then with X, Y bounded more tightly (solvers sometimes fail
+    # on one formulation and solve another cleanly).
+    objectives = [controller_objective] + [o for o in ("coupling", "margin") if o != controller_objective]
+    variants = [(o, bound) for o in objectives] + [("margin", bound * 1e-2)]
     tries = []
-    b = backoff
     best = None
-    while True:
+    for b in schedule:
         gK = gamma * (1.0 + b)
-        try:
-            Ak, Bk, Ck, Dk, info = _controller_at(work0, gK / gscale, solver, bound,
-                                                  objective=controller_objective)
+        for objective, bnd in variants:
+            try:
+                Ak, Bk, Ck, Dk, info = _controller_at(work0, gK / gscale, solver, bnd, objective=objective,
+                                                     gscale=gscale)
+            except (InfeasibleError, SolverError) as exc:
+                tries.append({"objective": objective, "bound": bnd, "backoff": b, "gamma_target": gK,
+                              "error": str(exc)})
+                continue
             Ak, Bk, Ck, Dk = _add_d22(Ak, Bk, Ck, Dk, D22)
-            # undo the u/y normalisation: u = su * K_s(sy * y)
-            Ks = ss(Ak, Bk * sy[None, :], su[:, None] * Ck, su[:, None] * Dk * sy[None, :])
-            K = ss(Ks.A, Ks.B, Ks.C, Ks.D, inputs=P.output_labels[-nmeas:],
-                   outputs=P.input_labels[-ncon:], name="K")
+            # undo the time scaling K(s) = K_w(s / alpha), then u = su * K_s(sy * y)
+            ra = np.sqrt(lev.alpha)
+            Ak, Bk, Ck = lev.alpha * Ak, ra * Bk, ra * Ck
+            K = ss(Ak, Bk * sy[None, :], su[:, None] * Ck, su[:, None] * Dk * sy[None, :],
+                   inputs=P.output_labels[-nmeas:], outputs=P.input_labels[-ncon:], name="K")
             CL, stable, maxre, value, wpk, sly, gpk = _verify(P, K, nmeas, ncon)
-            ok = stable and value <= gK * (1 + 1e-6)
-            tries.append({"backoff": b, "gamma_target": gK, "stable": stable, "closed_loop_norm": value,
-                          **info})
+            tries.append({"objective": objective, "bound": bnd, "backoff": b, "gamma_target": gK,
+                          "stable": stable, "closed_loop_norm": value, **info})
             cand = (K, CL, stable, maxre, value, wpk, sly, gpk, gK, b)
             if best is None or (stable and (not best[2] or value < best[4])):
                 best = cand
-            if ok:
+            if stable and value <= gK * (1 + 1e-6):
                 break
-        except (InfeasibleError, SolverError) as exc:
-            tries.append({"backoff": b, "gamma_target": gK, "error": str(exc)})
-        if b * 10 > max_backoff + 1e-15:
+        if best is not None and best[2] and best[4] <= best[8] * (1 + 1e-6):
             break
-        b *= 10
     if best is None or not best[2]:
+        last = {}
+        for t in tries:
+            last[t["objective"]] = t.get("error") or f"closed loop unstable at backoff {t['backoff']:g}"
         raise SolverError("H-infinity synthesis: no stabilizing controller passed the check "
-                          f"(optimal level gamma={gamma:.6g}); attempts: {tries}")
+                          f"(optimal level gamma={gamma:.6g}; {len(tries)} attempts at backoffs "
+                          f"{schedule[0]:g}..{schedule[-1]:g}); last outcome per objective: "
+                          + "; ".join(f"{k}: {v}" for k, v in last.items()))
     K, CL, stable, maxre, value, wpk, sly, gpk, gK, b = best
     if value > gK * (1 + 1e-6):
         notes.append(f"the best controller found achieves {value:.6g}, above the target level {gK:.6g}")
@@ -698,6 +869,6 @@ def hinfsyn(P, nmeas: int, ncon: int, *, solver: str = "CLARABEL", backoff: floa
                       closed_loop_norm_slycot=sly, closed_loop_norm_grid=gpk, peak_frequency=wpk,
                       stable=stable, max_closed_loop_real_part=maxre, controller_poles=poles,
                       backoff=b, notes=notes, solver=solver, seconds=time.perf_counter() - t0,
-                      info={"tries": tries, "level_status": st1, "levels": levels, "gamma_lmi": gamma_lmi,
-                            "level_method": level_method, "state_scaling": tstate,
+                      info={"tries": tries, "level_status": lev.status, "levels": lev.levels, "gamma_lmi": lev.gamma_lmi,
+                            "level_method": lev.method, "state_scaling": lev.tstate,
                             "u_scaling": su, "y_scaling": sy})

@@ -1,0 +1,249 @@
+"""Figures for the demos and the book (matplotlib, safe with the Agg backend).
+
+Every function draws on axes it is given or creates, and returns the figure
+or axes; nothing here computes more than a frequency response.  Frequencies
+are in rad/s, magnitudes in dB unless stated.
+"""
+from __future__ import annotations
+
+import os
+
+import numpy as np
+
+from .lti import as_ss, freqresp, sigma_max
+
+__all__ = ["frequency_grid", "bode_mag", "bode_phase", "sigma_plot", "closed_loop_figure",
+           "controller_figure", "sigma_figure", "two_mass_hinf_figures"]
+
+
+def _plt():
+    # pyplot falls back to Agg by itself when no display is available
+    import matplotlib.pyplot as plt
+    return plt
+
+
+def frequency_grid(*systems, decades: float = 1.5, n: int = 800) -> np.ndarray:
+    """Log-spaced grid (rad/s) covering the pole magnitudes of ``systems``.
+
+    The grid extends ``decades`` beyond the slowest and fastest nonzero pole
+    and contains the imaginary parts of lightly damped poles, so resonance
+    peaks are not missed.
+    """
+    mags, extra = [], []
+    for s in systems:
+        s = as_ss(s)
+        if s.nstates:
+            p = np.linalg.eigvals(np.asarray(s.A, float))
+            mags.extend(np.abs(p[np.abs(p) > 0]))
+            extra.extend(np.abs(p.imag[np.abs(p.imag) > 0]))
+    if not mags:
+        return np.logspace(-2, 2, n)
+    lo = np.log10(min(mags)) - decades
+    hi = np.log10(max(mags)) + decades
+    return np.unique(np.concatenate([np.logspace(lo, hi, n), extra]))
+
+
+def _db(x):
+    return 20.0 * np.log10(np.maximum(np.abs(x), 1e-300))
+
+
+def bode_mag(ax, sys, omega, output: int = 0, input: int = 0, db: bool = True, **kw):
+    """Plot ``|G_ij(j w)|`` of one channel on ``ax`` (dB if ``db``, else absolute).
+
+    Parameters
+    ----------
+    ax : matplotlib.axes.Axes
+    sys : control.StateSpace
+    omega : array_like
+        Frequencies in rad/s.
+    output, input : int
+        Channel indices.
+    db : bool
+        Plot ``20 log10 |G|`` (default) or ``|G|``.
+    **kw
+        Passed to :meth:`matplotlib.axes.Axes.semilogx`.
+
+    Returns
+    -------
+    matplotlib.axes.Axes
+    """
+    G = freqresp(sys, omega)[output, input]
+    ax.semilogx(omega, _db(G) if db else np.abs(G), **kw)
+    ax.set_xlabel("frequency [rad/s]")
+    ax.set_ylabel("magnitude [dB]" if db else "magnitude")
+    ax.grid(True, which="both", alpha=0.3)
+    return ax
+
+
+def bode_phase(ax, sys, omega, output: int = 0, input: int = 0, **kw):
+    """Plot the unwrapped phase (degrees) of one channel on ``ax``."""
+    G = freqresp(sys, omega)[output, input]
+    ax.semilogx(omega, np.degrees(np.unwrap(np.angle(G))), **kw)
+    ax.set_xlabel("frequency [rad/s]")
+    ax.set_ylabel("phase [deg]")
+    ax.grid(True, which="both", alpha=0.3)
+    return ax
+
+
+def sigma_plot(ax, sys, omega, db: bool = False, **kw):
+    """Plot the largest singular value of ``G(j w)`` on ``ax`` (absolute by default)."""
+    s = sigma_max(sys, omega)
+    ax.semilogx(omega, _db(s) if db else s, **kw)
+    ax.set_xlabel("frequency [rad/s]")
+    ax.set_ylabel("largest singular value" + (" [dB]" if db else ""))
+    ax.grid(True, which="both", alpha=0.3)
+    return ax
+
+
+def closed_loop_figure(CL, omega=None, P=None, input_names=None, output_names=None, title=None):
+    """Magnitude of every channel of a closed loop (thesis Fig. 2.6 analogue).
+
+    Parameters
+    ----------
+    CL : control.StateSpace
+        Closed loop ``w -> z``.
+    omega : array_like, optional
+        Frequencies in rad/s (default: :func:`frequency_grid`).
+    P : control.StateSpace, optional
+        Generalized plant; if given, its open-loop ``w -> z`` channels
+        (control input left at zero) are drawn dashed for comparison.
+    input_names, output_names : list of str, optional
+        Axis labels (default: the system's signal names).
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+    """
+    plt = _plt()
+    CL = as_ss(CL)
+    nz, nw = CL.noutputs, CL.ninputs
+    omega = frequency_grid(CL) if omega is None else np.asarray(omega, float)
+    input_names = input_names or list(CL.input_labels)
+    output_names = output_names or list(CL.output_labels)
+    fig, axes = plt.subplots(nz, nw, figsize=(4.2 * nw, 2.8 * nz), sharex=True, squeeze=False)
+    G = freqresp(CL, omega)
+    G0 = None
+    if P is not None:
+        P = as_ss(P)
+        G0 = freqresp(P, omega)[:nz, :nw]
+    for i in range(nz):
+        for j in range(nw):
+            ax = axes[i, j]
+            ax.semilogx(omega, _db(G[i, j]), label="closed loop")
+            if G0 is not None and np.any(np.abs(G0[i, j]) > 0):
+                ax.semilogx(omega, _db(G0[i, j]), "--", lw=1, label="open loop (u = 0)")
+            top = float(np.max(_db(G[i, j])))
+            # undamped open-loop peaks and exact notches are infinite: clip the view
+            ax.set_ylim(max(float(np.min(_db(G[i, j]))), top - 120.0) - 5.0, top + 40.0)
+            ax.set_title(f"{input_names[j]} -> {output_names[i]}", fontsize=9)
+            ax.grid(True, which="both", alpha=0.3)
+            if j == 0:
+                ax.set_ylabel("magnitude [dB]")
+            if i == nz - 1:
+                ax.set_xlabel("frequency [rad/s]")
+    if G0 is not None:
+        axes[0, 0].legend(fontsize=8)
+    if title:
+        fig.suptitle(title)
+    fig.tight_layout()
+    return fig
+
+
+def controller_figure(K, omega=None, title=None):
+    """Bode magnitude and phase of a SISO controller (thesis Fig. 2.7 analogue).
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+    """
+    plt = _plt()
+    K = as_ss(K)
+    omega = frequency_grid(K) if omega is None else np.asarray(omega, float)
+    fig, (a1, a2) = plt.subplots(2, 1, figsize=(6.4, 5.0), sharex=True)
+    bode_mag(a1, K, omega)
+    a1.set_xlabel("")
+    a1.set_ylabel("|K| [dB re 1 N/m]")
+    bode_phase(a2, K, omega)
+    if title:
+        fig.suptitle(title)
+    fig.tight_layout()
+    return fig
+
+
+def sigma_figure(CL, omega=None, levels=None, title=None):
+    """Largest singular value of a closed loop against frequency, with
+    horizontal reference levels (thesis Fig. 2.8 analogue).
+
+    Parameters
+    ----------
+    CL : control.StateSpace
+    omega : array_like, optional
+        Frequencies in rad/s.
+    levels : dict of str -> float, optional
+        Horizontal lines to draw, e.g. ``{"optimal gamma": 1.0069}``.
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+    """
+    plt = _plt()
+    CL = as_ss(CL)
+    omega = frequency_grid(CL) if omega is None else np.asarray(omega, float)
+    fig, ax = plt.subplots(figsize=(6.4, 3.6))
+    sigma_plot(ax, CL, omega, label="closed loop")
+    styles = iter([":", "--", "-.", (0, (1, 3))])
+    for name, value in (levels or {}).items():
+        ax.axhline(value, ls=next(styles, ":"), color="k", lw=1, label=f"{name} = {value:.4f}")
+    ax.set_ylim(0.0, 1.15 * max([float(sigma_max(CL, omega).max())] + list((levels or {}).values())))
+    ax.legend(fontsize=8, loc="lower left")
+    if title:
+        ax.set_title(title)
+    fig.tight_layout()
+    return fig
+
+
+def two_mass_hinf_figures(res, P, outdir) -> list[str]:
+    """Save the analogues of thesis Figures 2.6-2.8 for the two-mass H-infinity design.
+
+    Parameters
+    ----------
+    res : mutext.hinf.HinfResult
+        Result of :func:`mutext.hinf.hinfsyn` on ``P``.
+    P : control.StateSpace
+        The generalized plant (inputs ``f1, f2, u``; outputs ``z1, z2, y``).
+    outdir : str or path
+        Directory (created if missing).
+
+    Returns
+    -------
+    list of str
+        Paths of the PNG files written: closed-loop channels (Fig. 2.6),
+        controller frequency response (Fig. 2.7), largest singular value of
+        the closed loop (Fig. 2.8).
+    """
+    from .examples.two_mass import THESIS_GAMMA
+
+    plt = _plt()
+    os.makedirs(outdir, exist_ok=True)
+    omega = np.logspace(-1, 3, 1200)
+    omega = np.unique(np.concatenate([omega, frequency_grid(P, decades=0.0, n=2)]))
+    files = []
+    figs = [
+        ("two_mass_fig2_6_closed_loop.png",
+         closed_loop_figure(res.CL, omega, P=P,
+                            input_names=["f1 (f_e / 10 N)", "f2 (eta / 1e-4 m)"],
+                            output_names=["z1 (x1 / x_max)", "z2 (u / u_max)"],
+                            title="closed-loop channels (normalised signals)")),
+        ("two_mass_fig2_7_controller.png",
+         controller_figure(res.K, omega, title=f"H-infinity controller ({res.controller_order} states)")),
+        ("two_mass_fig2_8_sigma.png",
+         sigma_figure(res.CL, omega, levels={"optimal gamma (LMI)": res.gamma,
+                                             "thesis gamma": THESIS_GAMMA},
+                      title="largest singular value of the closed loop")),
+    ]
+    for name, fig in figs:
+        path = os.path.join(str(outdir), name)
+        fig.savefig(path, dpi=120)
+        plt.close(fig)
+        files.append(path)
+    return files
