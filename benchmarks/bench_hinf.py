@@ -62,8 +62,13 @@ def cases(count, first_seed):
 
 def _case_child(i, count, first_seed, timeout, q):
     name, desc, P, nmeas, ncon = list(cases(count, first_seed))[i]
-    ref = slycot_reference(P, nmeas, ncon, timeout)
-    q.put((i, name, desc, ref, ours(P, nmeas, ncon)))
+    ref = ("error", np.nan, "", 0.0)
+    try:
+        ref = slycot_reference(P, nmeas, ncon, timeout)
+        res = ours(P, nmeas, ncon)
+    except Exception as exc:  # a crash is a result too: report it in the table
+        res = {"error": f"crashed: {type(exc).__name__}: {str(exc)[:80]}", "seconds": 0.0}
+    q.put((i, name, desc, ref, res))
 
 
 def run_cases(ncases, count, first_seed, timeout, jobs):

@@ -27,7 +27,7 @@ def frequency_grid(*systems, decades: float = 1.5, n: int = 800) -> np.ndarray:
 
     The grid extends ``decades`` beyond the slowest and fastest nonzero pole
     and contains the imaginary parts of lightly damped poles, so resonance
-    peaks are not missed.
+    peaks are not missed (undamped poles: points 0.1 % either side).
     """
     mags, extra = [], []
     for s in systems:
@@ -35,7 +35,12 @@ def frequency_grid(*systems, decades: float = 1.5, n: int = 800) -> np.ndarray:
         if s.nstates:
             p = np.linalg.eigvals(np.asarray(s.A, float))
             mags.extend(np.abs(p[np.abs(p) > 0]))
-            extra.extend(np.abs(p.imag[np.abs(p.imag) > 0]))
+            osc = p[np.abs(p.imag) > 0]
+            undamped = np.abs(osc.real) <= 1e-12 * np.abs(osc)
+            extra.extend(np.abs(osc.imag[~undamped]))
+            # an undamped mode has infinite gain at its frequency: sample either side
+            w0 = np.abs(osc.imag[undamped])
+            extra.extend(np.concatenate([w0 * (1 - 1e-3), w0 * (1 + 1e-3)]))
     if not mags:
         return np.logspace(-2, 2, n)
     lo = np.log10(min(mags)) - decades
@@ -117,7 +122,9 @@ def closed_loop_figure(CL, omega=None, P=None, input_names=None, output_names=No
     plt = _plt()
     CL = as_ss(CL)
     nz, nw = CL.noutputs, CL.ninputs
-    omega = frequency_grid(CL) if omega is None else np.asarray(omega, float)
+    if omega is None:
+        omega = frequency_grid(CL) if P is None else frequency_grid(CL, P)
+    omega = np.asarray(omega, float)
     input_names = input_names or list(CL.input_labels)
     output_names = output_names or list(CL.output_labels)
     fig, axes = plt.subplots(nz, nw, figsize=(4.2 * nw, 2.8 * nz), sharex=True, squeeze=False)
@@ -226,7 +233,7 @@ def two_mass_hinf_figures(res, P, outdir) -> list[str]:
     plt = _plt()
     os.makedirs(outdir, exist_ok=True)
     omega = np.logspace(-1, 3, 1200)
-    omega = np.unique(np.concatenate([omega, frequency_grid(P, decades=0.0, n=2)]))
+    omega = np.unique(np.concatenate([omega, frequency_grid(P, decades=0.5, n=2)]))
     files = []
     figs = [
         ("two_mass_fig2_6_closed_loop.png",
