@@ -1,0 +1,116 @@
+r"""The three-mass rig of thesis chapter 3 (ECP Model 210a rectilinear plant), Table 3.1.
+
+Three carts on a track.  The spring arrangement used here is the chain
+
+.. code-block:: text
+
+    m1 --k1-- m2 --k2-- m3 --k3-- ground,   c_i from cart i to ground,
+
+which is the one the identification arithmetic of Table 3.1 implies: with
+the other carts clamped, cart 1 feels ``k1`` only (``k1 = k1eq``), cart 2 feels
+``k1 + k2`` (``k2 = k2eq - k1``) and cart 3 feels ``k2 + k3``
+(``k3 = k3eq - k2``).  (The thesis text says the grounded spring is on the first
+cart; that would contradict its own arithmetic.)  It also puts every trial's
+unmodeled dynamics on cart 3 alone: changing ``k3``, ``m3`` or ``c3`` adds a
+force that depends on ``x3`` only, which is why the thesis places the
+identifying controller there.
+
+Excitation and measurement are at cart 1.  SI units throughout (kg, N/m, N s/m).
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass, replace
+
+import control as ct
+import numpy as np
+
+from ..errors import ModelError
+from ..lti import mck_to_ss
+
+__all__ = ["ThreeMass", "TABLE_3_1", "mechanical_model", "matrices", "Trial", "TRIALS"]
+
+
+@dataclass(frozen=True)
+class ThreeMass:
+    """Parameters of the three-mass rig (SI units)."""
+    m1: float = 2.8113   # kg, cart 1 (0.8113) + 2.0 kg
+    m2: float = 2.6396   # kg
+    m3: float = 2.6074   # kg
+    k1: float = 842.3    # N/m, cart 1 to cart 2
+    k2: float = 806.5    # N/m, cart 2 to cart 3
+    k3: float = 386.0    # N/m, cart 3 to ground
+    c1: float = 5.2992   # N s/m, cart 1 bearings
+    c2: float = 1.9467   # N s/m
+    c3: float = 10.7375  # N s/m, cart 3 (1.9297) + air damper (8.8078)
+
+    def with_(self, **kw) -> "ThreeMass":
+        """A copy with some fields changed."""
+        return replace(self, **kw)
+
+
+#: Identified parameters of thesis Table 3.1.
+TABLE_3_1 = ThreeMass()
+
+
+def matrices(p: ThreeMass = TABLE_3_1):
+    """Mass, damping and stiffness matrices ``(M, C, K)`` of the chain (SI)."""
+    for name in ("m1", "m2", "m3", "k1", "k2", "k3", "c1", "c2", "c3"):
+        v = getattr(p, name)
+        if not np.isfinite(v) or v < 0 or (name.startswith("m") and v == 0):
+            raise ModelError(f"three-mass parameter {name} must be {'positive' if name[0] == 'm' else 'non-negative'}"
+                             f", got {v}")
+    M = np.diag([p.m1, p.m2, p.m3])
+    K = np.array([[p.k1, -p.k1, 0.0],
+                  [-p.k1, p.k1 + p.k2, -p.k2],
+                  [0.0, -p.k2, p.k2 + p.k3]])
+    C = np.diag([p.c1, p.c2, p.c3])
+    return M, C, K
+
+
+def mechanical_model(p: ThreeMass = TABLE_3_1) -> ct.StateSpace:
+    """Inputs ``f1`` (N on cart 1, the exciter) and ``f3`` (N on cart 3);
+    outputs ``x1``, ``x3`` (m)."""
+    M, C, K = matrices(p)
+    return mck_to_ss(M, C, K, inputs={"f1": 0, "f3": 2}, outputs={"x1": 0, "x3": 2},
+                     dof_names=["x1", "x2", "x3"])
+
+
+@dataclass(frozen=True)
+class Trial:
+    """One model-based identification trial of thesis sec. 3.4.
+
+    ``engineering`` and ``true`` are the two rigs; ``uncertainty`` the relative
+    uncertainty of the true system's changed parameters; ``Wz`` (m) and
+    ``mu`` the thesis's final values; ``Du`` the known difference as the
+    added mechanical impedance ``dm s^2 + dc s + dk`` on cart 3.
+    """
+    name: str
+    engineering: ThreeMass
+    true: ThreeMass
+    uncertainty: float
+    Wz: float
+    mu: float
+    Du: dict
+
+
+def _trials():
+    t = TABLE_3_1
+    k_g, m_g, c_g = 200.0, 1.6074, 5.7375
+    eng4 = t.with_(k3=k_g, m3=m_g, c3=c_g)
+
+    def du(a, b):
+        return {"dm": b.m3 - a.m3, "dc": b.c3 - a.c3, "dk": b.k3 - a.k3}
+
+    rows = [
+        ("1a", t.with_(k3=k_g), t, 0.01, 0.0004, 0.9337),
+        ("1b", t, t.with_(k3=k_g), 0.01, 0.0004, 0.8930),
+        ("2", t.with_(m3=m_g), t, 0.01, 0.000091, 0.9492),
+        ("3", t.with_(c3=c_g), t, 0.01, 0.00006, 0.9816),
+        ("4", eng4, t, 0.01, 0.0005, 0.9881),
+        ("5", eng4, t, 0.10, 0.0026, 0.9846),
+    ]
+    return {n: Trial(n, e, tr, u, wz, mu, du(e, tr)) for n, e, tr, u, wz, mu in rows}
+
+
+#: Trials 1a-5 with the thesis's guessed (engineering) and true values.
+TRIALS = _trials()
