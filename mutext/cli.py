@@ -76,6 +76,11 @@ def main(argv=None) -> int:
     except MutextError as exc:
         print(f"mutext {cmd}: error: {exc}", file=sys.stderr)
         return 1
+    except BrokenPipeError:
+        # output piped into e.g. `head`, which closed early: not an error of ours
+        import os
+        os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
+        return 0
     print(f"mutext: unknown command '{cmd}' (expected 'demo' or 'grade')", file=sys.stderr)
     return 2
 

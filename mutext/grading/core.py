@@ -1,0 +1,251 @@
+"""Exercises, questions, scoring and reports of the autograder."""
+from __future__ import annotations
+
+import importlib
+import threading
+import time
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Callable
+
+from ..errors import MutextError
+from .sandbox import Job, run_submission
+
+__all__ = ["GradingError", "Call", "Question", "Exercise", "QuestionReport", "Report", "EXERCISES",
+           "get_exercise", "grade"]
+
+
+class GradingError(MutextError):
+    """The grader was used wrongly (unknown exercise, missing submission file)."""
+
+
+@dataclass
+class Call:
+    """One call of the student's function: a label for the feedback and JSON arguments."""
+    label: str
+    args: list = field(default_factory=list)
+    kwargs: dict = field(default_factory=dict)
+
+
+@dataclass
+class Question:
+    """A graded question: the function to call, how, and how to score what it returns.
+
+    ``check(outcomes)`` receives one dict per call, ``{"ok": True, "value": ...}``
+    or ``{"ok": False, "error": "..."}``, and returns ``(score, feedback_lines)``
+    with ``0 <= score <= points``.
+    """
+    id: str
+    function: str
+    title: str
+    points: float
+    kind: str                    # "ss" or "float": what the function must return
+    calls: list
+    check: Callable
+
+    @property
+    def name(self) -> str:
+        return f"({self.id}) {self.function}: {self.title}"
+
+
+@dataclass
+class Exercise:
+    name: str
+    title: str
+    questions: Callable          # () -> list[Question]; built lazily (references cost time)
+    stub: str = ""               # path of the file students fill in, relative to the repository
+    prepare: Callable | None = None   # expensive reference computations, run while the child works
+
+
+@dataclass
+class QuestionReport:
+    id: str
+    name: str
+    score: float
+    max_score: float
+    feedback: list
+    status: str = "ok"
+
+    @property
+    def output(self) -> str:
+        return "\n".join(self.feedback)
+
+
+@dataclass
+class Report:
+    exercise: str
+    title: str
+    submission: str
+    questions: list
+    seconds: float = 0.0
+    notes: list = field(default_factory=list)
+
+    @property
+    def score(self) -> float:
+        return round(sum(q.score for q in self.questions), 2)
+
+    @property
+    def max_score(self) -> float:
+        return round(sum(q.max_score for q in self.questions), 2)
+
+    def to_gradescope(self) -> dict:
+        """The ``results.json`` schema of Gradescope (also written by otter-grader)."""
+        return {
+            "score": float(self.score),
+            "execution_time": round(self.seconds, 2),
+            "output": "\n".join([f"{self.exercise}: {self.score:g} / {self.max_score:g}"] + self.notes),
+            "tests": [{"name": q.name, "score": float(q.score), "max_score": float(q.max_score),
+                       "output": q.output} for q in self.questions],
+        }
+
+    def text(self) -> str:
+        """Human-readable report: points and feedback per question, then the total."""
+        lines = [f"Exercise {self.exercise}: {self.title}", f"Submission: {self.submission}", ""]
+        lines += [f"note: {n}" for n in self.notes]
+        if self.notes:
+            lines.append("")
+        width = max(len(q.name) for q in self.questions)
+        for q in self.questions:
+            lines.append(f"{q.name:<{width}}  {q.score:5.2f} / {q.max_score:g}")
+            lines += [f"    {f}" for f in q.feedback]
+        lines += ["", f"Total: {self.score:.2f} / {self.max_score:g}"]
+        return "\n".join(lines)
+
+
+#: name -> (module with ``EXERCISE``, one-line description)
+EXERCISES = {
+    "ex01_two_mass_hinf": ("mutext.grading.ex01_two_mass_hinf",
+                           "two-mass system: mechanical model, generalized plant, H-infinity norm, controller"),
+}
+
+
+def get_exercise(name: str) -> Exercise:
+    """The exercise called ``name`` (or the only one starting with ``name``, e.g. ``ex01``)."""
+    found = [n for n in EXERCISES if n == name] or [n for n in EXERCISES if n.startswith(name)]
+    if len(found) != 1:
+        raise GradingError(f"unknown exercise '{name}'. Available: {', '.join(EXERCISES)} "
+                           "(mutext grade --list)")
+    return importlib.import_module(EXERCISES[found[0]][0]).EXERCISE
+
+
+def _collapse(lines, labels):
+    """Say once what went wrong identically for every call (e.g. NotImplementedError)."""
+    if len(labels) < 2:
+        return lines
+    tags = [f"[{lab}] " for lab in labels]
+    by_msg = {}
+    for line in lines:
+        for t in tags:
+            if line.startswith(t):
+                by_msg.setdefault(line[len(t):], set()).add(t)
+    common = [m for m, ts in by_msg.items() if len(ts) == len(tags)]
+    out = []
+    for line in lines:
+        tag = next((t for t in tags if line.startswith(t)), None)
+        if tag is not None and line[len(tag):] in common:
+            msg = line[len(tag):]
+            if msg not in out:
+                out.append(msg)
+        else:
+            out.append(line)
+    return out
+
+
+def _quietly(fn):
+    try:
+        fn()
+    except Exception:   # noqa: BLE001 - the check that needs the result reports the error
+        pass
+
+
+def _clip(x, hi):
+    return round(min(max(float(x), 0.0), float(hi)), 2)
+
+
+def grade(exercise: str, submission, time_limit: float = 60.0) -> Report:
+    """Grade ``submission`` (a ``.py`` file) for ``exercise``.
+
+    The submission runs in a child process (:mod:`mutext.grading.sandbox`)
+    that can neither import the grader nor open its files; the scores are
+    computed here from the plain numbers it returns.
+
+    Integrity policy: an attempt to open the grader's files, to import
+    ``mutext.grading``, ``mutext.examples`` or ``mutext.demos``, to start a
+    process or to load native code with :mod:`ctypes` is blocked.  If it
+    happens while a question's function runs, that question scores 0; if it
+    happens at import time (module level), every question scores 0.
+
+    Parameters
+    ----------
+    exercise : str
+        Exercise name (see :data:`EXERCISES`); a unique prefix is accepted.
+    submission : path-like
+        The student's file.
+    time_limit : float
+        Seconds allowed for importing the submission and for each question.
+
+    Returns
+    -------
+    Report
+
+    Raises
+    ------
+    GradingError
+        Unknown exercise, or the submission file does not exist.
+    """
+    ex = get_exercise(exercise)
+    path = Path(submission)
+    if not path.is_file():
+        raise GradingError(f"submission file not found: {submission}")
+    if path.suffix != ".py":
+        raise GradingError(f"a submission is a Python file (.py), got {path.name}")
+    t0 = time.perf_counter()
+    questions = ex.questions()
+    jobs = [Job(q.id, q.function, q.kind, [{"args": c.args, "kwargs": c.kwargs} for c in q.calls])
+            for q in questions]
+    warm = None
+    if ex.prepare is not None:
+        # the reference computations overlap with the child's run; checks wait for them
+        warm = threading.Thread(target=_quietly, args=(ex.prepare,), daemon=True)
+        warm.start()
+    res = run_submission(path, jobs, time_limit=time_limit)
+    imp = res.import_
+    reports, notes = [], []
+    import_violation = "; ".join(dict.fromkeys(imp.violations))
+    if imp.violations:
+        notes.append(f"integrity violation at import time, all questions score 0: {import_violation}")
+    for q in questions:
+        o = res.questions[q.id]
+        if imp.status != "ok":
+            fb = [f"the submission could not be imported: {imp.error}"]
+            if imp.status == "crashed" and res.stderr_tail:
+                fb.append("last error output: " + res.stderr_tail.strip().splitlines()[-1])
+            reports.append(QuestionReport(q.id, q.name, 0.0, q.points, fb, imp.status))
+            continue
+        if imp.violations:
+            reports.append(QuestionReport(q.id, q.name, 0.0, q.points,
+                                          [f"0 points: integrity violation when the file was imported "
+                                           f"({import_violation})"], "violation"))
+            continue
+        if o.violations:
+            what = "; ".join(dict.fromkeys(o.violations))
+            reports.append(QuestionReport(q.id, q.name, 0.0, q.points,
+                                          [f"0 points: integrity violation, {q.function}() tried {what}"],
+                                          "violation"))
+            continue
+        if o.status != "ok":
+            msg = o.error or o.status
+            if isinstance(o.last_call, int) and 0 <= o.last_call < len(q.calls) and len(q.calls) > 1:
+                msg += f" [while {q.function}() ran on: {q.calls[o.last_call].label}]"
+            reports.append(QuestionReport(q.id, q.name, 0.0, q.points, [msg], o.status))
+            continue
+        outcomes = list(o.calls) + [{"ok": False, "error": "no result"}] * (len(q.calls) - len(o.calls))
+        try:
+            score, fb = q.check(outcomes)
+        except Exception as exc:   # noqa: BLE001 - an unforeseen return value must not stop the report
+            score, fb = 0.0, [f"the returned value could not be checked ({type(exc).__name__}: {exc})"]
+        fb = _collapse(list(fb), [c.label for c in q.calls])
+        reports.append(QuestionReport(q.id, q.name, _clip(score, q.points), q.points, fb))
+    if warm is not None:
+        warm.join()   # never leave a solver running in a thread at interpreter exit
+    return Report(ex.name, ex.title, str(submission), reports, time.perf_counter() - t0, notes)
