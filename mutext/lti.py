@@ -353,16 +353,22 @@ def freqresp(sys, omega) -> np.ndarray:
     Bh = Qh.T @ B
     Ch = C @ Qh
     n = A.shape[0]
-    for k, w in enumerate(omega):
-        X = sla.solve(1j * w * np.eye(n) - H, Bh, check_finite=False)
-        out[:, :, k] = Ch @ X + D
+    # batched solves, in chunks that keep the stacked matrices near 16 MB
+    chunk = max(1, int(2 ** 20 // (n * n)))
+    eye = np.eye(n)
+    for s in range(0, omega.size, chunk):
+        w = omega[s:s + chunk]
+        X = np.linalg.solve(1j * w[:, None, None] * eye - H[None], Bh[None])
+        out[:, :, s:s + chunk] = np.moveaxis(Ch[None] @ X, 0, -1) + D[:, :, None]
     return out
 
 
 def sigma_max(sys, omega) -> np.ndarray:
     """Largest singular value of ``G(j w)`` at each frequency (rad/s)."""
     G = freqresp(sys, omega)
-    return np.array([np.linalg.norm(G[:, :, k], 2) for k in range(G.shape[2])])
+    if min(G.shape[:2]) == 0:
+        return np.zeros(G.shape[2])
+    return np.linalg.svd(np.moveaxis(G, -1, 0), compute_uv=False)[:, 0]
 
 
 def is_stable(sys, margin: float = 0.0) -> bool:
