@@ -1,0 +1,606 @@
+r"""Frequency-response files and a virtual test rig.
+
+Measured frequency response functions (FRFs) of the rotor rig are exchanged
+as small text files, one input-output channel per file.
+
+File format
+-----------
+::
+
+    # input_station: 12
+    # input_quantity: current
+    # input_unit: A
+    # output_station: 13
+    # output_quantity: displacement
+    # output_unit: um
+    # speed_hz: 10
+    # rig: cracked rotor, ball bearings
+    freq_hz,re,im
+    20.0,1.25e+01,-3.1e-01
+    20.5,1.27e+01,-3.3e-01
+    ...
+
+* Header lines ``# key: value`` come first.  Required keys:
+  ``input_station`` (int), ``input_quantity`` (``force`` or ``current``),
+  ``input_unit`` (``N`` for a force, ``A`` for a current),
+  ``output_station`` (int), ``output_quantity`` (``displacement``),
+  ``output_unit`` (``m``, ``mm``, ``um`` or ``in``).  Optional:
+  ``speed_hz`` (float, running speed).  Any other ``# key: value`` is kept
+  as metadata (strings).  Keys are case-sensitive and may appear once.
+* Then the CSV header line ``freq_hz,re,im`` and one row per frequency:
+  frequency in Hz (positive, strictly increasing) and the real and
+  imaginary parts of the response in ``output_unit`` per ``input_unit``
+  (e.g. um/A).  Blank lines are ignored.
+
+:func:`read_frf` converts the response to SI (m/N or m/A).  Every format error
+raises :class:`FRFFileError` naming the file, the line and the field.
+
+The virtual rig :func:`measure` produces the same :class:`FRF` objects from
+a model, with optional measurement noise, so that identification code can be
+exercised on data with a known truth.  The thesis sweeps ([Mad]_ sec. 4.3)
+were linear sine sweeps from 20 to 1000 Hz in 0.5 Hz steps with a 0.1 A
+exciter current at 10 Hz running speed, truncated to 20-225 Hz because the
+response above is dominated by noise; :func:`sweep_frequencies` reproduces
+that grid.
+
+References
+----------
+.. [Mad] R. J. Madden, *Identification of unmodeled dynamics in rotor systems
+   using mu-synthesis approach*, M.S. thesis, Cleveland State University,
+   ch. 4.
+.. [Pin] R. Pintelon and J. Schoukens, *System Identification: A Frequency
+   Domain Approach*, 2nd ed., Wiley-IEEE Press, 2012, sec. 2.4 (circular
+   complex normal noise on FRF measurements).
+"""
+from __future__ import annotations
+
+import glob as _glob
+import math
+import os
+from dataclasses import dataclass, field, replace
+from pathlib import Path
+from typing import Mapping, Sequence
+
+import numpy as np
+
+from .errors import ModelError
+
+__all__ = [
+    "FRF", "FRFFileError", "Noise", "read_frf", "write_frf", "read_frfs", "measure",
+    "sweep_frequencies", "INPUT_UNITS", "OUTPUT_UNITS", "CSV_HEADER",
+    "THESIS_SWEEP_HZ", "THESIS_ANALYSIS_BAND_HZ", "THESIS_EXCITATION_A", "THESIS_SPEED_HZ",
+]
+
+#: CSV header line that separates the ``#`` header from the data.
+CSV_HEADER = "freq_hz,re,im"
+
+#: Allowed input quantities and their unit (the SI unit; factor to SI is 1).
+INPUT_UNITS: dict[str, dict[str, float]] = {"force": {"N": 1.0}, "current": {"A": 1.0}}
+
+#: Allowed output quantities and units, with the factor that converts to metres.
+OUTPUT_UNITS: dict[str, dict[str, float]] = {
+    "displacement": {"m": 1.0, "mm": 1e-3, "um": 1e-6, "in": 0.0254},
+}
+
+#: Thesis sine sweep: start, stop, step [Hz] ([Mad]_ sec. 4.3).
+THESIS_SWEEP_HZ = (20.0, 1000.0, 0.5)
+#: Band kept for the identification (noise above 225 Hz).
+THESIS_ANALYSIS_BAND_HZ = (20.0, 225.0)
+#: Exciter current amplitude of the sweeps [A].
+THESIS_EXCITATION_A = 0.1
+#: Running speed during the sweeps [Hz].
+THESIS_SPEED_HZ = 10.0
+
+_REQUIRED = ("input_station", "input_quantity", "input_unit",
+             "output_station", "output_quantity", "output_unit")
+_RESERVED = _REQUIRED + ("speed_hz",)
+
+
+class FRFFileError(ModelError):
+    """A malformed FRF file; the message names the file, the line and the field.
+
+    Attributes
+    ----------
+    path : str
+    line : int or None
+        1-based line number, or None for whole-file problems.
+    field : str or None
+        Header key or CSV column concerned.
+    """
+
+    def __init__(self, path, line, field, problem):
+        self.path = str(path)
+        self.line = line
+        self.field = field
+        self.problem = problem
+        where = self.path if line is None else f"{self.path}, line {line}"
+        what = f" [{field}]" if field else ""
+        super().__init__(f"{where}{what}: {problem}")
+
+
+@dataclass
+class FRF:
+    r"""One measured or simulated frequency-response channel, in SI units.
+
+    Attributes
+    ----------
+    freq_hz : ndarray, shape (n,)
+        Frequencies [Hz], positive and strictly increasing.
+    response : ndarray of complex, shape (n,)
+        :math:`G(j\omega)` in m/N (force input) or m/A (current input).
+    input_station, output_station : int or None
+        Station numbers (as in the rotor station table).  Required to write
+        a file.
+    input_quantity : {"force", "current"}
+    output_quantity : {"displacement"}
+    speed_hz : float or None
+        Running speed during the measurement [Hz].
+    metadata : dict of str -> str
+        Any other header entries.
+    source : pathlib.Path or None
+        File the FRF was read from.
+    """
+    freq_hz: np.ndarray
+    response: np.ndarray
+    input_station: int | None = None
+    output_station: int | None = None
+    input_quantity: str = "force"
+    output_quantity: str = "displacement"
+    speed_hz: float | None = None
+    metadata: dict = field(default_factory=dict)
+    source: Path | None = None
+
+    def __post_init__(self):
+        self.freq_hz = np.asarray(self.freq_hz, dtype=float).ravel()
+        self.response = np.asarray(self.response, dtype=complex).ravel()
+        if self.freq_hz.shape != self.response.shape:
+            raise ModelError(f"FRF: {self.freq_hz.size} frequencies but {self.response.size} "
+                             f"response values")
+        if self.freq_hz.size == 0:
+            raise ModelError("FRF: no frequencies")
+        if not np.all(np.isfinite(self.freq_hz)) or np.any(self.freq_hz <= 0):
+            raise ModelError("FRF: frequencies must be finite and positive [Hz]")
+        if np.any(np.diff(self.freq_hz) <= 0):
+            k = int(np.argmax(np.diff(self.freq_hz) <= 0))
+            raise ModelError(f"FRF: frequencies must be strictly increasing; "
+                             f"{self.freq_hz[k + 1]} Hz follows {self.freq_hz[k]} Hz")
+        if not np.all(np.isfinite(self.response)):
+            k = int(np.argmax(~np.isfinite(self.response)))
+            raise ModelError(f"FRF: non-finite response at {self.freq_hz[k]} Hz")
+        if self.input_quantity not in INPUT_UNITS:
+            raise ModelError(f"FRF: input_quantity must be one of {sorted(INPUT_UNITS)}, "
+                             f"got {self.input_quantity!r}")
+        if self.output_quantity not in OUTPUT_UNITS:
+            raise ModelError(f"FRF: output_quantity must be one of {sorted(OUTPUT_UNITS)}, "
+                             f"got {self.output_quantity!r}")
+
+    @property
+    def omega(self) -> np.ndarray:
+        """Frequencies in rad/s."""
+        return 2.0 * np.pi * self.freq_hz
+
+    @property
+    def input_unit(self) -> str:
+        """SI unit of the input (``N`` or ``A``)."""
+        return next(iter(INPUT_UNITS[self.input_quantity]))
+
+    @property
+    def output_unit(self) -> str:
+        """SI unit of the output (``m``)."""
+        return "m"
+
+    @property
+    def unit(self) -> str:
+        """Unit of :attr:`response`, e.g. ``m/A``."""
+        return f"{self.output_unit}/{self.input_unit}"
+
+    def response_in(self, output_unit: str) -> np.ndarray:
+        """The response expressed in ``output_unit`` per SI input unit (e.g. ``um`` -> um/A)."""
+        units = OUTPUT_UNITS[self.output_quantity]
+        if output_unit not in units:
+            raise ModelError(f"unknown {self.output_quantity} unit {output_unit!r}; "
+                             f"allowed: {', '.join(units)}")
+        return self.response / units[output_unit]
+
+    def band(self, fmin: float, fmax: float) -> "FRF":
+        """The part of the FRF with ``fmin <= f <= fmax`` [Hz] (e.g. the 20-225 Hz analysis band)."""
+        keep = (self.freq_hz >= fmin) & (self.freq_hz <= fmax)
+        if not np.any(keep):
+            raise ModelError(f"FRF has no frequency in [{fmin}, {fmax}] Hz "
+                             f"(it covers {self.freq_hz[0]}-{self.freq_hz[-1]} Hz)")
+        return replace(self, freq_hz=self.freq_hz[keep], response=self.response[keep],
+                       metadata=dict(self.metadata))
+
+
+# ----------------------------------------------------------------------------
+# reading and writing
+# ----------------------------------------------------------------------------
+
+def _parse_float(text: str, path, line: int, fld: str, allow_nonfinite: bool = False) -> float:
+    try:
+        v = float(text)
+    except ValueError:
+        raise FRFFileError(path, line, fld, f"{text.strip()!r} is not a number") from None
+    if not allow_nonfinite and not math.isfinite(v):
+        raise FRFFileError(path, line, fld, f"value is {text.strip()} (NaN or infinite values "
+                                            f"are not allowed)")
+    return v
+
+
+def _parse_int(text: str, path, line: int, fld: str) -> int:
+    try:
+        return int(text.strip())
+    except ValueError:
+        raise FRFFileError(path, line, fld, f"{text.strip()!r} is not an integer") from None
+
+
+def read_frf(path) -> FRF:
+    """Read one FRF file (format in the module docstring); the response is converted to SI.
+
+    Parameters
+    ----------
+    path : str or os.PathLike
+
+    Returns
+    -------
+    FRF
+        With ``source`` set to the path.  The units found in the file are
+        kept in ``metadata['file_output_unit']`` and
+        ``metadata['file_input_unit']``.
+
+    Raises
+    ------
+    FRFFileError
+        Naming the file, the line (1-based) and the field for: a header line
+        not of the form ``# key: value``, a repeated key, a missing required
+        key, an unknown quantity or unit, a station that is not an integer,
+        a missing or wrong CSV header, a row without three columns, a value
+        that is not a number or is NaN/infinite, a non-positive or
+        non-increasing frequency, and a file without data rows.
+    """
+    path = Path(path)
+    try:
+        text = path.read_text(encoding="utf-8-sig")
+    except OSError as exc:
+        raise FRFFileError(path, None, None, f"cannot read file: {exc.strerror or exc}") from None
+    lines = text.splitlines()
+    header: dict[str, tuple[str, int]] = {}
+    i = 0
+    # --- '# key: value' header
+    while i < len(lines):
+        raw = lines[i].strip()
+        if raw == "":
+            i += 1
+            continue
+        if not raw.startswith("#"):
+            break
+        body = raw[1:].strip()
+        key, sep, value = body.partition(":")
+        key, value = key.strip(), value.strip()
+        if not sep or not key:
+            raise FRFFileError(path, i + 1, None, f"header line {raw!r} is not of the form "
+                                                  f"'# key: value'")
+        if key in header:
+            raise FRFFileError(path, i + 1, key, f"key repeated (first given on line "
+                                                 f"{header[key][1]})")
+        header[key] = (value, i + 1)
+        i += 1
+    # --- CSV header
+    if i >= len(lines):
+        raise FRFFileError(path, None, None, f"missing CSV header line {CSV_HEADER!r} "
+                                             f"after the '#' header (file ends at line {len(lines)})")
+    csv_line = i + 1
+    cols = [c.strip().lower() for c in lines[i].split(",")]
+    if cols != CSV_HEADER.split(","):
+        raise FRFFileError(path, csv_line, None, f"expected the CSV header line {CSV_HEADER!r}, "
+                                                 f"got {lines[i].strip()!r}")
+    # --- required keys and their values
+    for key in _REQUIRED:
+        if key not in header:
+            raise FRFFileError(path, None, key, f"missing required header key '{key}' "
+                                                f"(required: {', '.join(_REQUIRED)})")
+    in_station = _parse_int(header["input_station"][0], path, header["input_station"][1],
+                            "input_station")
+    out_station = _parse_int(header["output_station"][0], path, header["output_station"][1],
+                             "output_station")
+    in_q, ln = header["input_quantity"]
+    if in_q not in INPUT_UNITS:
+        raise FRFFileError(path, ln, "input_quantity", f"unknown quantity {in_q!r}; allowed: "
+                                                       f"{', '.join(INPUT_UNITS)}")
+    in_u, ln = header["input_unit"]
+    if in_u not in INPUT_UNITS[in_q]:
+        raise FRFFileError(path, ln, "input_unit", f"unknown unit {in_u!r} for a {in_q} input; "
+                                                   f"allowed: {', '.join(INPUT_UNITS[in_q])}")
+    out_q, ln = header["output_quantity"]
+    if out_q not in OUTPUT_UNITS:
+        raise FRFFileError(path, ln, "output_quantity", f"unknown quantity {out_q!r}; allowed: "
+                                                        f"{', '.join(OUTPUT_UNITS)}")
+    out_u, ln = header["output_unit"]
+    if out_u not in OUTPUT_UNITS[out_q]:
+        raise FRFFileError(path, ln, "output_unit", f"unknown unit {out_u!r} for a {out_q} "
+                                                    f"output; allowed: "
+                                                    f"{', '.join(OUTPUT_UNITS[out_q])}")
+    speed = None
+    if "speed_hz" in header:
+        speed = _parse_float(header["speed_hz"][0], path, header["speed_hz"][1], "speed_hz")
+    # --- data rows
+    freqs, vals = [], []
+    names = CSV_HEADER.split(",")
+    for j in range(i + 1, len(lines)):
+        raw = lines[j].strip()
+        if raw == "":
+            continue
+        if raw.startswith("#"):
+            raise FRFFileError(path, j + 1, None, "header line after the CSV header "
+                                                  "(all '# key: value' lines must come first)")
+        parts = raw.split(",")
+        if len(parts) != 3:
+            raise FRFFileError(path, j + 1, None, f"expected 3 comma-separated values "
+                                                  f"({CSV_HEADER}), got {len(parts)}")
+        f, re_, im_ = (_parse_float(p, path, j + 1, n) for p, n in zip(parts, names))
+        if f <= 0:
+            raise FRFFileError(path, j + 1, "freq_hz", f"frequency {f} Hz is not positive")
+        if freqs and f <= freqs[-1][0]:
+            raise FRFFileError(path, j + 1, "freq_hz",
+                               f"frequency {f} Hz is not greater than the previous one "
+                               f"({freqs[-1][0]} Hz on line {freqs[-1][1]}); frequencies "
+                               f"must be strictly increasing")
+        freqs.append((f, j + 1))
+        vals.append(complex(re_, im_))
+    if not freqs:
+        raise FRFFileError(path, csv_line, None, "no data rows after the CSV header")
+    scale = OUTPUT_UNITS[out_q][out_u] / INPUT_UNITS[in_q][in_u]
+    meta = {k: v for k, (v, _) in header.items() if k not in _RESERVED}
+    meta["file_output_unit"] = out_u
+    meta["file_input_unit"] = in_u
+    return FRF(freq_hz=np.array([f for f, _ in freqs]), response=np.array(vals) * scale,
+               input_station=in_station, output_station=out_station, input_quantity=in_q,
+               output_quantity=out_q, speed_hz=speed, metadata=meta, source=path)
+
+
+def write_frf(path, frf: FRF, *, output_unit: str = "m") -> Path:
+    """Write an FRF in the file format of this module.
+
+    Parameters
+    ----------
+    path : str or os.PathLike
+    frf : FRF
+        Its stations must be set.  Metadata entries other than the reserved
+        keys are written as ``# key: value`` lines (keys and values must be
+        single-line; keys may not contain ':').
+    output_unit : {"m", "mm", "um", "in"}
+        Unit of the written response (per N or per A).  Values are written
+        with 17 significant digits, so reading back reproduces them to
+        rounding (exactly for ``m``).
+
+    Returns
+    -------
+    pathlib.Path
+    """
+    path = Path(path)
+    if frf.input_station is None or frf.output_station is None:
+        raise ModelError(f"write_frf {path}: input_station and output_station must be set "
+                         f"(got {frf.input_station}, {frf.output_station})")
+    units = OUTPUT_UNITS[frf.output_quantity]
+    if output_unit not in units:
+        raise ModelError(f"write_frf {path}: unknown {frf.output_quantity} unit "
+                         f"{output_unit!r}; allowed: {', '.join(units)}")
+    lines = [
+        f"# input_station: {int(frf.input_station)}",
+        f"# input_quantity: {frf.input_quantity}",
+        f"# input_unit: {frf.input_unit}",
+        f"# output_station: {int(frf.output_station)}",
+        f"# output_quantity: {frf.output_quantity}",
+        f"# output_unit: {output_unit}",
+    ]
+    if frf.speed_hz is not None:
+        lines.append(f"# speed_hz: {float(frf.speed_hz)!r}")
+    for k, v in frf.metadata.items():
+        if k in ("file_output_unit", "file_input_unit") or k in _RESERVED:
+            continue
+        k, v = str(k), str(v)
+        if ":" in k or "\n" in k or "\n" in v or not k.strip():
+            raise ModelError(f"write_frf {path}: metadata key {k!r} / value {v!r} cannot be "
+                             f"written as a '# key: value' line")
+        lines.append(f"# {k.strip()}: {v.strip()}")
+    lines.append(CSV_HEADER)
+    G = frf.response_in(output_unit)
+    for f, g in zip(frf.freq_hz, G):
+        lines.append(f"{float(f)!r},{float(g.real)!r},{float(g.imag)!r}")
+    path.write_text("\n".join(lines) + "\n", encoding="utf-8")
+    return path
+
+
+def read_frfs(paths_or_glob) -> list[FRF]:
+    """Read several FRF files.
+
+    Parameters
+    ----------
+    paths_or_glob : str, os.PathLike or iterable of them
+        A glob pattern (``"data/cracked_*.frf"``; matches are sorted by
+        name), a single path, or a sequence of paths (kept in order).
+
+    Returns
+    -------
+    list of FRF
+    """
+    if isinstance(paths_or_glob, (str, os.PathLike)):
+        pattern = os.fspath(paths_or_glob)
+        if _glob.has_magic(pattern):
+            paths = sorted(_glob.glob(pattern))
+            if not paths:
+                raise ModelError(f"read_frfs: no file matches the pattern {pattern!r}")
+        else:
+            paths = [pattern]
+    else:
+        paths = list(paths_or_glob)
+        if not paths:
+            raise ModelError("read_frfs: empty list of paths")
+    return [read_frf(p) for p in paths]
+
+
+# ----------------------------------------------------------------------------
+# virtual rig
+# ----------------------------------------------------------------------------
+
+def sweep_frequencies(start: float = 20.0, stop: float = 225.0, step: float = 0.5) -> np.ndarray:
+    """Linear sine-sweep frequencies [Hz]: ``start, start+step, ...`` up to ``stop`` inclusive.
+
+    The defaults give the thesis analysis band (20-225 Hz in 0.5 Hz steps,
+    411 points); ``sweep_frequencies(*THESIS_SWEEP_HZ)`` the full 20-1000 Hz
+    sweep.  The grid is computed as ``start + k*step`` (no accumulated
+    rounding); ``stop`` is included when it lies on the grid to 1e-9 steps.
+    """
+    start, stop, step = float(start), float(stop), float(step)
+    if not (math.isfinite(start) and math.isfinite(stop) and math.isfinite(step)):
+        raise ModelError("sweep_frequencies: start, stop and step must be finite")
+    if start <= 0 or step <= 0 or stop < start:
+        raise ModelError(f"sweep_frequencies: need 0 < start <= stop and step > 0 [Hz], got "
+                         f"start={start}, stop={stop}, step={step}")
+    n = int(math.floor((stop - start) / step + 1e-9)) + 1
+    return start + step * np.arange(n)
+
+
+@dataclass(frozen=True)
+class Noise:
+    r"""Measurement noise of the virtual rig.
+
+    At each frequency the measured response is
+
+    .. math::
+        \hat G(j\omega) = G(j\omega) + \sigma(\omega)\,\frac{n_r + j n_i}{\sqrt2},
+        \qquad \sigma = \text{relative}\cdot|G(j\omega)| + \text{floor},
+
+    with :math:`n_r, n_i` independent standard normal, i.e. circular complex
+    Gaussian noise with :math:`E|\hat G - G|^2 = \sigma^2` ([Pin]_).  The
+    relative part models the gain/phase scatter of the sine-sweep
+    correlation, the floor the sensor noise that dominates away from the
+    resonances (the reason for truncating the thesis sweeps at 225 Hz).
+
+    Attributes
+    ----------
+    relative : float
+        Standard deviation relative to :math:`|G|` [-], e.g. 0.01 for 1 %.
+    floor : float
+        Absolute standard deviation in SI response units (m/N or m/A).
+    """
+    relative: float = 0.0
+    floor: float = 0.0
+
+    def __post_init__(self):
+        for name in ("relative", "floor"):
+            v = getattr(self, name)
+            if not (math.isfinite(v) and v >= 0):
+                raise ModelError(f"Noise.{name} must be finite and >= 0, got {v}")
+
+
+def _as_noise(noise) -> Noise | None:
+    if noise is None:
+        return None
+    if isinstance(noise, Noise):
+        return noise
+    if isinstance(noise, (int, float)):
+        return Noise(relative=float(noise))
+    if isinstance(noise, (tuple, list)) and len(noise) == 2:
+        return Noise(relative=float(noise[0]), floor=float(noise[1]))
+    if isinstance(noise, Mapping):
+        return Noise(**noise)
+    raise ModelError(f"noise must be None, a Noise, a relative level (float) or a pair "
+                     f"(relative, floor); got {noise!r}")
+
+
+def _port_index(spec, labels: Sequence[str], n: int, what: str) -> int:
+    if isinstance(spec, (int, np.integer)):
+        if not 0 <= spec < n:
+            raise ModelError(f"measure: {what} index {spec} is outside 0..{n - 1}")
+        return int(spec)
+    if isinstance(spec, str):
+        if spec not in labels:
+            raise ModelError(f"measure: the system has no {what} named {spec!r}; "
+                             f"{what}s are {list(labels)}")
+        return list(labels).index(spec)
+    raise ModelError(f"measure: {what} must be an index or a name, got {spec!r}")
+
+
+def _response(system, input, output, omega) -> np.ndarray:
+    """Frequency response of one channel at omega [rad/s]."""
+    import control as ct
+
+    if isinstance(system, (ct.StateSpace, ct.TransferFunction)) or (
+            isinstance(system, tuple) and len(system) == 4):
+        from .lti import as_ss, freqresp
+        sys = as_ss(system, "measure: system")
+        i = _port_index(input, sys.input_labels, sys.ninputs, "input")
+        o = _port_index(output, sys.output_labels, sys.noutputs, "output")
+        return freqresp(sys, omega)[o, i, :]
+    if callable(system):
+        G = np.asarray(system(omega), dtype=complex)
+        if G.shape == omega.shape:
+            if input not in (0, None) or output not in (0, None):
+                raise ModelError("measure: a callable returning one channel takes input=0, output=0")
+            return G
+        if G.ndim == 3 and G.shape[2] == omega.size:
+            i = _port_index(input, [], G.shape[1], "input")
+            o = _port_index(output, [], G.shape[0], "output")
+            return G[o, i, :]
+        raise ModelError(f"measure: the callable returned shape {G.shape}; expected "
+                         f"({omega.size},) or (noutputs, ninputs, {omega.size})")
+    if hasattr(system, "frequency_response"):      # other python-control LTI objects (FRD, ...)
+        G = np.asarray(system.frequency_response(omega, squeeze=False).fresp, dtype=complex)
+        i = _port_index(input, getattr(system, "input_labels", []), G.shape[1], "input")
+        o = _port_index(output, getattr(system, "output_labels", []), G.shape[0], "output")
+        return G[o, i, :]
+    raise ModelError(f"measure: cannot compute a frequency response of a {type(system).__name__}; "
+                     f"pass a control.StateSpace/TransferFunction, an (A, B, C, D) tuple or a "
+                     f"callable omega[rad/s] -> response")
+
+
+def measure(system, input=0, output=0, freq_hz=None, *, noise=None, rng=None,
+            input_station: int | None = None, output_station: int | None = None,
+            input_quantity: str = "force", output_quantity: str = "displacement",
+            speed_hz: float | None = None, metadata: Mapping[str, str] | None = None) -> FRF:
+    r"""Virtual sine-sweep measurement of one channel of a model.
+
+    Parameters
+    ----------
+    system : control.StateSpace, control.TransferFunction, (A, B, C, D) or callable
+        The "rig".  Its response must be in SI units (m/N or m/A).  A callable
+        maps angular frequencies [rad/s] to the response, either of shape
+        ``(n,)`` (one channel) or ``(noutputs, ninputs, n)``.
+    input, output : int or str
+        Channel: index or name (``input_labels`` / ``output_labels``).
+    freq_hz : array_like, optional
+        Frequencies [Hz]; default :func:`sweep_frequencies` (20-225 Hz,
+        0.5 Hz steps, as the truncated thesis sweeps).
+    noise : None, float, (relative, floor) or Noise
+        Measurement noise (see :class:`Noise`); ``None`` or 0 for exact data.
+    rng : numpy.random.Generator or int, optional
+        Random generator or seed (for reproducible noise).
+    input_station, output_station : int, optional
+        Station numbers stored in the FRF (needed to write it to a file).
+    input_quantity : {"force", "current"}
+    output_quantity : {"displacement"}
+    speed_hz : float, optional
+        Running speed stored in the FRF [Hz].
+    metadata : mapping, optional
+        Extra metadata; ``noise_relative`` and ``noise_floor`` are added when
+        noise is applied.
+
+    Returns
+    -------
+    FRF
+    """
+    f = sweep_frequencies() if freq_hz is None else np.asarray(freq_hz, dtype=float).ravel()
+    omega = 2.0 * np.pi * f
+    G = _response(system, input, output, omega)
+    meta = {str(k): str(v) for k, v in (metadata or {}).items()}
+    nz = _as_noise(noise)
+    if nz is not None and (nz.relative > 0 or nz.floor > 0):
+        gen = rng if isinstance(rng, np.random.Generator) else np.random.default_rng(rng)
+        sigma = nz.relative * np.abs(G) + nz.floor
+        G = G + sigma * (gen.standard_normal(G.size) + 1j * gen.standard_normal(G.size)) / np.sqrt(2.0)
+        meta["noise_relative"] = repr(nz.relative)
+        meta["noise_floor"] = repr(nz.floor)
+    return FRF(freq_hz=f, response=G, input_station=input_station, output_station=output_station,
+               input_quantity=input_quantity, output_quantity=output_quantity, speed_hz=speed_hz,
+               metadata=meta)

@@ -1,0 +1,323 @@
+r"""Analyses of an assembled model: modes, Campbell diagram, FRFs, state space.
+
+All inputs and outputs are SI: frequencies in Hz where the name says ``_hz``,
+otherwise rad/s; speeds in rad/s; displacements in m; forces in N; currents in A.
+
+Eigenvalue problem
+------------------
+At spin speed :math:`\Omega` the free motion :math:`q = \hat q e^{\lambda t}` satisfies
+
+.. math::
+    \left(\lambda^2 M + \lambda (C + \Omega G) + K\right)\hat q = 0 ,
+
+solved in first-order form :math:`\dot x = A x`,
+:math:`A = \begin{bmatrix} 0 & I\\ -M^{-1}K & -M^{-1}(C+\Omega G)\end{bmatrix}`
+(Friswell et al. 2010, ch. 3 and 5).  Without damping and rotation the
+symmetric-definite problem :math:`K\phi = \omega^2 M\phi` is solved instead
+(``scipy.linalg.eigh``), which is more accurate.  Natural frequencies are the
+imaginary parts :math:`\omega_d = \mathrm{Im}\,\lambda > 0`; rigid-body modes
+(:math:`|\lambda|` below ``1e-6`` times the largest) are left out.
+
+Whirl direction
+---------------
+For a mode :math:`\lambda = j\omega` (:math:`\omega > 0`) of a rotor spinning
+about +z, the station orbit is forward (same sense as the spin) when
+:math:`\hat v \approx -j\hat u`.  The index
+
+.. math:: w = \frac{-2\sum_n \mathrm{Im}(\bar{\hat u}_n \hat v_n)}{\sum_n |\hat u_n|^2 + |\hat v_n|^2}
+    \in [-1, 1]
+
+is +1 for circular forward whirl, -1 for circular backward whirl and 0 for a
+planar (straight-line) orbit.
+
+Frequency response
+------------------
+.. math::
+    H(j\omega) = C_y\left(K - \omega^2 M + j\omega(C + \Omega G)\right)^{-1} B ,
+
+one complex linear solve per frequency (no state-space detour).
+
+References
+----------
+M. I. Friswell, J. E. T. Penny, S. D. Garvey and A. W. Lees, *Dynamics of
+Rotating Machines*, Cambridge University Press, 2010, ch. 3 and 5.
+"""
+from __future__ import annotations
+
+import contextlib
+from dataclasses import dataclass, field
+from typing import Sequence
+
+import numpy as np
+import scipy.linalg as sla
+
+from ..errors import ModelError
+from ..lti import mck_to_ss
+
+__all__ = ["Modes", "FRF", "Campbell", "modes", "natural_frequencies", "campbell", "frf",
+           "state_space", "whirl_index", "blas_single_thread"]
+
+
+def blas_single_thread():
+    """Context manager limiting BLAS/LAPACK to one thread, if ``threadpoolctl`` is installed.
+
+    The matrices here are small (hundreds of DOFs): a multi-threaded BLAS
+    gains nothing on them and, on a shared or oversubscribed machine, loses
+    10-20x to thread contention.  Without ``threadpoolctl`` this does nothing
+    (set ``OPENBLAS_NUM_THREADS=1`` in the environment instead).
+    """
+    try:
+        from threadpoolctl import threadpool_limits
+    except ImportError:
+        return contextlib.nullcontext()
+    return threadpool_limits(limits=1, user_api="blas")
+
+
+@dataclass
+class Modes:
+    """Modes of a model at one speed.
+
+    Attributes
+    ----------
+    eigenvalues : complex ndarray (n,)
+        :math:`\\lambda_r` [rad/s], sorted by increasing :math:`\\mathrm{Im}\\,\\lambda`.
+    omega : ndarray (n,)
+        Damped natural frequencies :math:`\\mathrm{Im}\\,\\lambda_r` [rad/s].
+    frequencies_hz : ndarray (n,)
+        The same in Hz.
+    damping_ratio : ndarray (n,)
+        :math:`-\\mathrm{Re}\\,\\lambda_r/|\\lambda_r|`.
+    shapes : complex ndarray (ndof, n)
+        Displacement part of the eigenvectors, scaled to a largest entry of 1.
+    whirl : ndarray (n,)
+        :func:`whirl_index` (rotor layout; NaN otherwise).
+    speed : float
+        Spin speed [rad/s].
+    dof_names : list of str
+    """
+    eigenvalues: np.ndarray
+    omega: np.ndarray
+    frequencies_hz: np.ndarray
+    damping_ratio: np.ndarray
+    shapes: np.ndarray
+    whirl: np.ndarray
+    speed: float
+    dof_names: list = field(default_factory=list)
+
+    def whirl_direction(self, threshold: float = 0.5) -> list[str]:
+        """``"forward"``, ``"backward"`` or ``"mixed"`` per mode (``""`` when not a rotor)."""
+        out = []
+        for w in self.whirl:
+            if np.isnan(w):
+                out.append("")
+            elif w > threshold:
+                out.append("forward")
+            elif w < -threshold:
+                out.append("backward")
+            else:
+                out.append("mixed")
+        return out
+
+
+@dataclass
+class FRF:
+    """Frequency response ``H[i, j, k]``: output ``i`` per unit input ``j`` at ``freqs_hz[k]``.
+
+    Units: output unit (m or rad) per input unit (N, N m or A).
+    """
+    freqs_hz: np.ndarray
+    H: np.ndarray
+    inputs: list
+    outputs: list
+    speed: float
+
+    def __call__(self, output: str, input: str) -> np.ndarray:
+        """The response from ``input`` to ``output`` (complex, one per frequency)."""
+        try:
+            return self.H[self.outputs.index(output), self.inputs.index(input)]
+        except ValueError:
+            raise ModelError(f"FRF has inputs {self.inputs} and outputs {self.outputs}; "
+                             f"asked for {input} -> {output}") from None
+
+
+@dataclass
+class Campbell:
+    """Campbell diagram data: ``frequencies_hz[i, r]`` and ``whirl[i, r]`` at ``speeds[i]`` [rad/s]."""
+    speeds: np.ndarray
+    frequencies_hz: np.ndarray
+    whirl: np.ndarray
+
+    @property
+    def speeds_rpm(self) -> np.ndarray:
+        return self.speeds * 60.0 / (2.0 * np.pi)
+
+
+def whirl_index(shape: np.ndarray, layout) -> float:
+    """Whirl index of one mode shape (see the module docstring); NaN unless a two-plane rotor."""
+    if layout.kind != "rotor":
+        return float("nan")
+    u = shape[0::4]
+    v = shape[1::4]
+    den = float(np.sum(np.abs(u) ** 2 + np.abs(v) ** 2))
+    if den == 0.0:
+        return 0.0
+    return float(-2.0 * np.sum(np.imag(np.conj(u) * v)) / den)
+
+
+def _speed(model, speed):
+    if speed is None:
+        return float(getattr(model, "speed", 0.0))
+    speed = float(speed)
+    if speed != 0.0 and getattr(model.layout, "kind", "") != "rotor":
+        raise ModelError(f"{model.name}: a nonzero speed needs a two-plane rotor model (planes=2)")
+    return speed
+
+
+def modes(model, *, speed: float | None = None, values=None, n: int | None = None,
+          rigid_tol: float = 1e-6, matrices=None) -> Modes:
+    """Modes of ``model`` (a :class:`~mutext.rotor.assembly.Structure`) at ``speed`` [rad/s].
+
+    Parameters
+    ----------
+    model : Structure or Rotor
+    speed : float, optional
+        Spin speed [rad/s]; default ``model.speed`` (0 for non-rotors).
+    values : mapping or array, optional
+        Parameter values (see :meth:`Structure.values`).
+    n : int, optional
+        Keep the ``n`` lowest modes.
+    rigid_tol : float
+        Relative threshold below which a mode counts as rigid-body and is dropped.
+    matrices : Matrices, optional
+        Precomputed ``model.matrices(values)``.
+    """
+    with blas_single_thread():
+        return _modes(model, _speed(model, speed), values, n, rigid_tol, matrices)
+
+
+def _modes(model, speed, values, n, rigid_tol, matrices) -> Modes:
+    M, C, K, G = model.matrices(values) if matrices is None else matrices
+    D = C + speed * G
+    ndof = M.shape[0]
+    try:
+        np.linalg.cholesky(M)
+    except np.linalg.LinAlgError:
+        raise ModelError(f"{model.name}: the mass matrix is not positive definite (every DOF needs mass "
+                         "or rotary inertia)") from None
+    if not np.any(D):
+        lam, Phi = sla.eigh(0.5 * (K + K.T), M)
+        scale = max(float(np.max(np.abs(lam))), 1e-300)
+        keep = lam > rigid_tol**2 * scale
+        w = np.sqrt(lam[keep])
+        ev = 1j * w
+        shapes = Phi[:, keep].astype(complex)
+        zeta = np.zeros_like(w)
+    else:
+        Minv = np.linalg.inv(M)
+        A = np.block([[np.zeros((ndof, ndof)), np.eye(ndof)], [-Minv @ K, -Minv @ D]])
+        lam, X = sla.eig(A)
+        scale = max(float(np.max(np.abs(lam))), 1e-300)
+        keep = lam.imag > rigid_tol * scale
+        ev = lam[keep]
+        order = np.argsort(ev.imag)
+        ev = ev[order]
+        shapes = X[:ndof, keep][:, order]
+        w = ev.imag
+        zeta = -ev.real / np.abs(ev)
+    if n is not None:
+        ev, w, zeta, shapes = ev[:n], w[:n], zeta[:n], shapes[:, :n]
+    for r in range(shapes.shape[1]):
+        k = int(np.argmax(np.abs(shapes[:, r])))
+        if shapes[k, r] != 0:
+            shapes[:, r] = shapes[:, r] / shapes[k, r]
+    whirl = np.array([whirl_index(shapes[:, r], model.layout) for r in range(shapes.shape[1])])
+    return Modes(ev, w, w / (2 * np.pi), zeta, shapes, whirl, speed, model.dof_names)
+
+
+def natural_frequencies(model, *, speed: float | None = None, values=None, n: int | None = None,
+                        matrices=None) -> np.ndarray:
+    """Damped natural frequencies [Hz] (rigid-body modes left out), lowest first."""
+    return modes(model, speed=speed, values=values, n=n, matrices=matrices).frequencies_hz
+
+
+def campbell(model, speeds: Sequence[float], *, n: int = 6, values=None) -> Campbell:
+    """Natural frequencies [Hz] and whirl indices of the ``n`` lowest modes at each speed [rad/s].
+
+    The matrices are evaluated once; modes are sorted by frequency at each
+    speed (no mode tracking across crossings).
+    """
+    speeds = np.atleast_1d(np.asarray(speeds, dtype=float))
+    with blas_single_thread():
+        mats = model.matrices(values)
+    F = np.full((speeds.size, n), np.nan)
+    W = np.full((speeds.size, n), np.nan)
+    for i, s in enumerate(speeds):
+        md = modes(model, speed=s, matrices=mats, n=n)
+        m = md.frequencies_hz.size
+        F[i, :m] = md.frequencies_hz
+        W[i, :m] = md.whirl
+    return Campbell(speeds, F, W)
+
+
+def _ports(model, inputs, outputs):
+    ins = model.input_names if inputs is None else list(inputs)
+    outs = model.output_names if outputs is None else list(outputs)
+    for q in ins:
+        if q not in model.input_names:
+            raise ModelError(f"{model.name}: unknown input '{q}' (inputs: {', '.join(model.input_names)})")
+    for q in outs:
+        if q not in model.output_names:
+            raise ModelError(f"{model.name}: unknown output '{q}' (outputs: {', '.join(model.output_names)})")
+    if not ins or not outs:
+        raise ModelError(f"{model.name}: needs at least one input and one output "
+                         f"(has inputs {model.input_names}, outputs {model.output_names})")
+    return ins, outs
+
+
+def frf(model, freqs_hz, *, inputs: Sequence[str] | None = None, outputs: Sequence[str] | None = None,
+        speed: float | None = None, values=None) -> FRF:
+    """Frequency responses between named ports at ``freqs_hz`` [Hz].
+
+    Default ports: all inputs and outputs of the model.  Returns an :class:`FRF`
+    with ``H`` of shape ``(noutputs, ninputs, nfreq)`` in output units per input unit.
+    """
+    speed = _speed(model, speed)
+    ins, outs = _ports(model, inputs, outputs)
+    f = np.atleast_1d(np.asarray(freqs_hz, dtype=float))
+    v = model.values(values)
+    with blas_single_thread():
+        return _frf(model, f, ins, outs, speed, v)
+
+
+def _frf(model, f, ins, outs, speed, v) -> FRF:
+    M, C, K, G = model.matrices(v)
+    B = model.input_matrix(v)[:, [model.input_names.index(q) for q in ins]]
+    Cy = model.output_matrix()[[model.output_names.index(q) for q in outs]]
+    D = C + speed * G
+    H = np.empty((len(outs), len(ins), f.size), dtype=complex)
+    w = 2 * np.pi * f
+    chunk = max(1, int(2_000_000 // max(M.size, 1)))     # about 32 MB of complex matrices at a time
+    for k0 in range(0, f.size, chunk):
+        wk = w[k0:k0 + chunk, None, None]
+        Z = K[None] - wk * wk * M[None] + 1j * wk * D[None]       # dynamic stiffness, batched
+        X = np.linalg.solve(Z, np.broadcast_to(B, (wk.shape[0],) + B.shape))
+        H[:, :, k0:k0 + chunk] = np.moveaxis(Cy[None] @ X, 0, -1)
+    return FRF(f, H, ins, outs, speed)
+
+
+def state_space(model, *, inputs: Sequence[str] | None = None, outputs: Sequence[str] | None = None,
+                speed: float | None = None, values=None):
+    """State-space model with named ports, via :func:`mutext.lti.mck_to_ss`.
+
+    State :math:`x = [q; \\dot q]` (SI); inputs in N, N m or A (exciter
+    currents, through the force per ampere); outputs in m or rad.
+    """
+    speed = _speed(model, speed)
+    ins, outs = _ports(model, inputs, outputs)
+    v = model.values(values)
+    with blas_single_thread():
+        M, C, K, G = model.matrices(v)
+    B = model.input_matrix(v)
+    in_map = {q: B[:, model.input_names.index(q)] for q in ins}
+    out_map = {q: model.output_dofs[model.output_names.index(q)] for q in outs}
+    return mck_to_ss(M, C + speed * G, K, inputs=in_map, outputs=out_map, dof_names=model.dof_names)
