@@ -843,6 +843,10 @@ def hinfsyn(P, nmeas: int, ncon: int, *, solver: str = "CLARABEL", backoff: floa
                               "error": str(exc)})
                 continue
             Ak, Bk, Ck, Dk = _add_d22(Ak, Bk, Ck, Dk, D22)
+            if not all(np.all(np.isfinite(X)) for X in (Ak, Bk, Ck, Dk)):
+                tries.append({"objective": objective, "bound": bnd, "backoff": b, "gamma_target": gK,
+                              "error": "controller reconstruction gave non-finite matrices"})
+                continue
             # undo the time scaling K(s) = K_w(s / alpha), then u = su * K_s(sy * y)
             ra = np.sqrt(lev.alpha)
             Ak, Bk, Ck = lev.alpha * Ak, ra * Bk, ra * Ck

@@ -226,7 +226,10 @@ def star(P, Q, nu: int, ny: int) -> ct.StateSpace:
     Q11, Q12, Q21, Q22 = Dq[:nu, :ny], Dq[:nu, ny:], Dq[nu:, :ny], Dq[nu:, ny:]
     # Solve the algebraic loop [u; y] = E^{-1} G [xP; xQ; wP; wQ].
     E = np.block([[np.eye(nu), -Q11], [-D22, np.eye(ny)]])
-    if E.size and np.linalg.cond(E) > 1e12:
+    # well posed iff I - D22*Q11 is invertible (the Schur complement of E); E's own
+    # condition number would also grow with a large but harmless |Q11| when D22 = 0
+    F = np.eye(ny) - D22 @ Q11
+    if not (np.all(np.isfinite(Q11)) and np.all(np.isfinite(D22))) or (F.size and np.linalg.cond(F) > 1e12):
         raise IllPosedError("interconnection is not well posed: I - D22*DK is singular "
                             "(the loop through the feedthrough terms has no unique solution)")
     G = np.block([

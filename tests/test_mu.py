@@ -1,0 +1,546 @@
+"""Structured singular value: bounds, certificates and frequency sweeps (mutext.mu).
+
+Reference values: Skogestad and Postlethwaite, *Multivariable Feedback Control*,
+2nd ed., example 8.5 (M = [[2, 2], [-1, -1]]); the rank-one formula
+mu(a b^H) = sum |a_i b_i| for complex scalar blocks; Packard and Doyle (1993)
+for the exactness of the D-scaling bound when 2S + F <= 3.
+"""
+import numpy as np
+import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
+
+from mutext import mu as mumod
+from mutext.errors import ModelError, SolverError
+from mutext.lti import freqresp, ss
+from mutext.mu import (Block, BlockStructure, dg_bound, mu_bounds, mu_lower, mu_sweep,
+                       mu_upper, scaled_sigma)
+
+
+def crandn(rng, *shape):
+    return rng.standard_normal(shape) + 1j * rng.standard_normal(shape)
+
+
+def check_lower(M, S, lo, rtol=1e-9):
+    """The perturbation returned with a lower bound proves it."""
+    assert lo.Delta is not None
+    assert S.contains(lo.Delta)
+    assert np.linalg.norm(lo.Delta, 2) == pytest.approx(1.0 / lo.value, rel=rtol)
+    # det(I - M Delta) = 0, measured by the smallest singular value
+    smin = np.linalg.svd(np.eye(M.shape[0]) - M @ lo.Delta, compute_uv=False)[-1]
+    assert smin < 1e-9 * (1 + np.linalg.norm(M, 2) / lo.value)
+
+
+def check_certificate(M, S, up, rtol=1e-9):
+    """The upper bound is the one its scalings certify (recomputed independently)."""
+    assert dg_bound(M, S, up.Dl, up.Dr, up.G) == pytest.approx(up.value, rel=rtol, abs=1e-12)
+    if up.method in ("osborne", "sigma"):
+        assert scaled_sigma(M, S, up.d) == pytest.approx(up.value, rel=rtol, abs=1e-12)
+
+
+SP_M = np.array([[2.0, 2.0], [-1.0, -1.0]])
+
+
+# -- known values ---------------------------------------------------------------------
+
+@pytest.mark.parametrize("shape", [(3, 3), (2, 4), (4, 1)])
+def test_full_block_is_max_singular_value(shape):
+    rng = np.random.default_rng(sum(shape))
+    M = crandn(rng, *shape)
+    S = BlockStructure([Block.full(shape[1], shape[0])])
+    smax = np.linalg.svd(M, compute_uv=False)[0]
+    up, lo = mu_upper(M, S), mu_lower(M, S)
+    assert up.value == pytest.approx(smax, rel=1e-6)
+    assert lo.value == pytest.approx(smax, rel=1e-6)
+    check_lower(M, S, lo)
+    check_certificate(M, S, up)
+
+
+def test_full_block_split_in_two_is_not_the_singular_value():
+    # guards the previous test: with two blocks the answer must change
+    S = BlockStructure([Block.full(1), Block.full(1)])
+    assert mu_upper(SP_M, S).value < np.linalg.norm(SP_M, 2) - 0.1
+
+
+@pytest.mark.parametrize("z", [3.0, -2.0 + 1.5j, 0.7j])
+def test_complex_scalar_is_modulus(z):
+    S = BlockStructure([Block.scalar()])
+    for method in ("lmi", "osborne"):
+        assert mu_upper([[z]], S, method=method).value == pytest.approx(abs(z), rel=1e-9)
+    lo = mu_lower([[z]], S)
+    assert lo.value == pytest.approx(abs(z), rel=1e-9)
+    check_lower(np.array([[z]]), S, lo)
+
+
+@pytest.mark.parametrize("y", [0.5, -3.0, 250.0])
+def test_real_scalar_with_imaginary_entry_has_mu_zero(y):
+    S = BlockStructure([Block.real()])
+    M = np.array([[1j * y]])
+    up = mu_upper(M, S, real="dg")
+    assert up.method == "lmi-dg"
+    assert up.value < 1e-6 * abs(y)
+    check_certificate(M, S, up)
+    assert mu_lower(M, S).value == 0.0
+    # treating the parameter as complex loses this: the bound is |z|
+    assert mu_upper(M, S, real="complex").value == pytest.approx(abs(y), rel=1e-6)
+    assert mu_upper(M, S, method="osborne").value == pytest.approx(abs(y), rel=1e-9)
+
+
+@pytest.mark.parametrize("z", [2.0, -0.3])
+def test_real_scalar_with_real_entry(z):
+    S = BlockStructure([Block.real()])
+    M = np.array([[z]], dtype=complex)
+    assert mu_upper(M, S).value == pytest.approx(abs(z), rel=1e-6)
+    lo = mu_lower(M, S)
+    assert lo.value == pytest.approx(abs(z), rel=1e-12)
+    check_lower(M, S, lo)
+    assert lo.Delta.imag.max() == 0.0
+
+
+def test_repeated_real_scalar_is_largest_real_eigenvalue():
+    # mu for delta*I_3 real: max |lambda| over the real eigenvalues of M
+    rng = np.random.default_rng(3)
+    V = rng.standard_normal((3, 3))
+    M = V @ np.array([[0.5, 0, 0], [0, 1.0, 2.0], [0, -2.0, 1.0]]) @ np.linalg.inv(V)   # 0.5, 1 +- 2j
+    S = BlockStructure([Block.real(3)])
+    lo = mu_lower(M, S)
+    assert lo.value == pytest.approx(0.5, rel=1e-9)
+    check_lower(M, S, lo)
+    up = mu_upper(M, S)
+    assert lo.value <= up.value * (1 + 1e-9)
+    assert up.value < np.abs(np.linalg.eigvals(M)).max()      # below the complex answer
+
+
+def test_skogestad_postlethwaite_example_8_5():
+    one_full = BlockStructure([Block.full(2)])
+    two_scalars = BlockStructure([Block.scalar(), Block.scalar()])
+    two_full = BlockStructure([Block.full(1), Block.full(1)])
+    assert mu_upper(SP_M, one_full).value == pytest.approx(np.sqrt(10), abs=5e-4)
+    assert mu_lower(SP_M, one_full).value == pytest.approx(3.162, abs=5e-4)
+    for S in (two_scalars, two_full):
+        for method in ("lmi", "osborne"):
+            up = mu_upper(SP_M, S, method=method)
+            assert up.value == pytest.approx(3.0, abs=1e-5)
+            check_certificate(SP_M, S, up)
+        lo = mu_lower(SP_M, S)
+        assert lo.value == pytest.approx(3.0, abs=1e-9)
+        check_lower(SP_M, S, lo)
+    assert float(mu_upper(SP_M, two_scalars)) == pytest.approx(3.0, abs=1e-5)
+
+
+@pytest.mark.parametrize("n", [2, 3, 5])
+def test_rank_one_complex_scalars(n):
+    rng = np.random.default_rng(10 + n)
+    a, b = crandn(rng, n), crandn(rng, n)
+    M = np.outer(a, b.conj())
+    exact = float(np.sum(np.abs(a * b)))
+    S = BlockStructure([Block.scalar() for _ in range(n)])
+    lo = mu_lower(M, S)
+    assert lo.value == pytest.approx(exact, rel=1e-9)
+    check_lower(M, S, lo)
+    assert mu_upper(M, S).value == pytest.approx(exact, rel=1e-5)
+    assert mu_upper(M, S, method="osborne").value == pytest.approx(exact, rel=1e-6)
+
+
+def test_rank_one_real_blocks_against_linear_program():
+    # det(I - a b^H Delta) = 1 - sum_i delta_i conj(b_i) a_i is linear in real delta, so
+    # 1/mu = min ||delta||_inf s.t. Re(c) delta = 1, Im(c) delta = 0 is a linear program
+    from scipy.optimize import linprog
+    rng = np.random.default_rng(4)
+    n = 4
+    a, b = crandn(rng, n), crandn(rng, n)
+    c = a * b.conj()
+    M = np.outer(a, b.conj())
+    # variables [delta, t]: minimise t with -t <= delta_i <= t
+    A_ub = np.block([[np.eye(n), -np.ones((n, 1))], [-np.eye(n), -np.ones((n, 1))]])
+    A_eq = np.vstack([np.append(c.real, 0.0), np.append(c.imag, 0.0)])
+    lp = linprog(np.append(np.zeros(n), 1.0), A_ub=A_ub, b_ub=np.zeros(2 * n), A_eq=A_eq,
+                 b_eq=[1.0, 0.0], bounds=[(None, None)] * n + [(0, None)], method="highs")
+    exact = 1.0 / lp.fun
+    S = BlockStructure([Block.real() for _ in range(n)])
+    lo = mu_lower(M, S)
+    assert lo.method == "real-local"
+    assert lo.value == pytest.approx(exact, rel=1e-6)
+    check_lower(M, S, lo)
+    assert np.abs(lo.Delta.imag).max() == 0.0
+    up = mu_upper(M, S, real="dg")
+    check_certificate(M, S, up)
+    assert up.value == pytest.approx(exact, rel=1e-4)          # D-G is exact for rank one
+    assert mu_upper(M, S, real="complex").value > 1.05 * exact  # complex D alone is not
+
+
+def test_rank_one_mixed_against_second_order_cone_program():
+    # with real blocks delta_i and complex blocks, det(I - a b^H Delta) = 0 reads
+    # sum_real delta_i c_i + w = 1 where w ranges over a disc of radius t * sum_complex |c_j|
+    import cvxpy as cp
+    rng = np.random.default_rng(8)
+    kinds = ["real", "real", "scalar", "full"]
+    a, b = crandn(rng, 4), crandn(rng, 4)
+    c = a * b.conj()
+    M = np.outer(a, b.conj())
+    R = sum(abs(c[i]) for i, k in enumerate(kinds) if k != "real")
+    ri = [i for i, k in enumerate(kinds) if k == "real"]
+    d, t = cp.Variable(len(ri)), cp.Variable()
+    resid = cp.hstack([1 - c[ri].real @ d, -(c[ri].imag @ d)])
+    cp.Problem(cp.Minimize(t), [cp.norm(resid) <= R * t, cp.abs(d) <= t]).solve(solver="CLARABEL")
+    exact = 1.0 / t.value
+    S = BlockStructure([Block.real(), Block.real(), Block.scalar(), Block.full(1)])
+    b_ = mu_bounds(M, S)
+    assert b_.lower.method == "real-search"
+    assert b_.lower.value == pytest.approx(exact, rel=1e-5)
+    check_lower(M, S, b_.lower)
+    assert b_.upper.value == pytest.approx(exact, rel=1e-4)
+    check_certificate(M, S, b_.upper)
+
+
+# -- exactness and agreement of the two upper bounds -----------------------------------
+
+EXACT_STRUCTURES = [
+    [Block.scalar(), Block.scalar(), Block.scalar()],
+    [Block.full(2), Block.scalar(), Block.full(1, 2)],
+    [Block.scalar(2), Block.full(2)],          # one repeated scalar and one full block: 2S + F = 3
+]
+
+
+@pytest.mark.parametrize("k", range(len(EXACT_STRUCTURES)))
+@pytest.mark.parametrize("seed", [0, 1, 2])
+def test_bounds_coincide_when_upper_bound_is_exact(k, seed):
+    S = BlockStructure(EXACT_STRUCTURES[k])
+    rng = np.random.default_rng(100 * k + seed)
+    M = crandn(rng, S.ncols, S.nrows)
+    b = mu_bounds(M, S)
+    assert b.upper.value - b.lower.value <= 1e-4 * b.upper.value
+    assert b.gap >= -1e-9 * b.upper.value
+    check_lower(M, S, b.lower)
+    check_certificate(M, S, b.upper)
+
+
+@pytest.mark.parametrize("seed", range(4))
+def test_osborne_agrees_with_lmi_for_diagonal_scalings(seed):
+    rng = np.random.default_rng(seed)
+    blocks = [Block.full(1), Block.full(2, 1), Block.scalar(), Block.full(2)][: 2 + seed % 3]
+    S = BlockStructure(blocks)
+    M = crandn(rng, S.ncols, S.nrows)
+    lmi, osb = mu_upper(M, S, method="lmi"), mu_upper(M, S, method="osborne")
+    assert lmi.method == "lmi-d" and osb.method == "osborne"
+    assert abs(lmi.value - osb.value) <= 1e-4 * lmi.value
+    check_certificate(M, S, lmi)
+    check_certificate(M, S, osb)
+
+
+@pytest.mark.parametrize("M, exact", [
+    ([[1.0, 5e6], [0.0, 1.0]], 1.0),              # triangular: the infimum needs d -> 0
+    ([[1e-3, 1e4], [1e-5, 2.0]], None),           # optimal scalings span 4.5 decades
+    ([[0.5, 1e8, 0.0], [0.0, 0.2, 1e8], [1e-9, 0.0, 0.3]], None),
+])
+def test_badly_scaled_matrices(M, exact):
+    M = np.array(M, dtype=complex)
+    S = BlockStructure([Block.scalar() for _ in range(M.shape[0])])
+    lmi, osb, lo = mu_upper(M, S), mu_upper(M, S, method="osborne"), mu_lower(M, S)
+    check_certificate(M, S, lmi)
+    check_certificate(M, S, osb)
+    check_lower(M, S, lo)
+    assert abs(lmi.value - osb.value) <= 1e-4 * osb.value
+    assert lo.value <= lmi.value * (1 + 1e-9)
+    if exact is not None:
+        assert lmi.value == pytest.approx(exact, rel=1e-6)
+        assert lo.value == pytest.approx(exact, rel=1e-9)
+    if M.shape[0] <= 3:                     # 1x1 blocks, at most three: the bounds meet
+        assert lo.value == pytest.approx(lmi.value, rel=1e-4)
+
+
+def test_osborne_is_conservative_for_repeated_scalars():
+    rng = np.random.default_rng(7)
+    S = BlockStructure([Block.scalar(3)])
+    M = crandn(rng, 3, 3)
+    rho = np.abs(np.linalg.eigvals(M)).max()
+    assert mu_upper(M, S).value == pytest.approx(rho, rel=1e-5)              # full D: exact
+    assert mu_upper(M, S, method="osborne").value > 1.01 * rho                 # d*I only: sigma_max
+
+
+# -- invariances ----------------------------------------------------------------------
+
+def test_scaling_by_commuting_d_leaves_mu_unchanged():
+    rng = np.random.default_rng(11)
+    S = BlockStructure([Block.scalar(2), Block.full(2)])
+    M = crandn(rng, 4, 4)
+    D1 = crandn(rng, 2, 2) + 3 * np.eye(2)      # any invertible matrix on the repeated scalar
+    Dl = np.zeros((4, 4), complex)
+    Dl[:2, :2], Dl[2:, 2:] = D1, 0.2 * np.eye(2)
+    M2 = Dl @ M @ np.linalg.inv(Dl)
+    b1, b2 = mu_bounds(M, S), mu_bounds(M2, S)
+    assert b2.upper.value == pytest.approx(b1.upper.value, rel=1e-5)
+    assert b2.lower.value == pytest.approx(b1.lower.value, rel=1e-4)
+    # the destabilising Delta of M also destabilises D M D^-1 (it commutes with D)
+    smin = np.linalg.svd(np.eye(4) - M2 @ b1.lower.Delta, compute_uv=False)[-1]
+    assert smin < 1e-9 * np.linalg.cond(Dl)
+
+
+def test_structured_unitary_and_complex_multiple():
+    rng = np.random.default_rng(12)
+    S = BlockStructure([Block.scalar(), Block.full(2), Block.scalar()])
+    M = crandn(rng, 4, 4)
+    b = mu_bounds(M, S)
+    U = S.assemble([np.exp(0.3j), np.linalg.qr(crandn(rng, 2, 2))[0], -1j])
+    bu = mu_bounds(U @ M, S)
+    assert bu.upper.value == pytest.approx(b.upper.value, rel=1e-5)
+    assert bu.lower.value == pytest.approx(b.lower.value, rel=1e-4)
+    alpha = 2.5 * np.exp(0.7j)
+    ba = mu_bounds(alpha * M, S)
+    assert ba.upper.value == pytest.approx(abs(alpha) * b.upper.value, rel=1e-5)
+    assert ba.lower.value == pytest.approx(abs(alpha) * b.lower.value, rel=1e-6)
+
+
+# -- lower <= upper on random problems --------------------------------------------------
+
+def block_strategy():
+    return st.one_of(
+        st.tuples(st.just("full"), st.integers(1, 2), st.integers(1, 2)),
+        st.tuples(st.just("scalar"), st.integers(1, 2), st.just(0)),
+        st.tuples(st.just("real"), st.integers(1, 2), st.just(0)),
+    )
+
+
+def make_structure(spec):
+    return BlockStructure([Block.full(r, c) if k == "full" else Block(k, r, r) for k, r, c in spec])
+
+
+def lower_never_exceeds_upper(spec, seed, real_matrix):
+    S = make_structure(spec)
+    rng = np.random.default_rng(seed)
+    M = rng.standard_normal((S.ncols, S.nrows)) if real_matrix else crandn(rng, S.ncols, S.nrows)
+    lo = mu_lower(M, S)
+    lmi = mu_upper(M, S, lower=lo.value)
+    osb = mu_upper(M, S, method="osborne")
+    assert lo.value <= lmi.value * (1 + 1e-8) + 1e-12
+    assert lmi.value <= osb.value * (1 + 1e-6)       # optimal (D, G) beat diagonal D
+    assert osb.value <= np.linalg.norm(M, 2) * (1 + 1e-12)
+    check_certificate(M, S, lmi)
+    check_certificate(M, S, osb)
+    if lo.value > 0:
+        check_lower(M, S, lo)
+
+
+@settings(max_examples=30, deadline=None, database=None)
+@given(spec=st.lists(block_strategy(), min_size=1, max_size=3), seed=st.integers(0, 2 ** 32 - 1),
+       real_matrix=st.booleans())
+def test_lower_never_exceeds_upper(spec, seed, real_matrix):
+    lower_never_exceeds_upper(spec, seed, real_matrix)
+
+
+@pytest.mark.slow
+@settings(max_examples=200, deadline=None, database=None)
+@given(spec=st.lists(block_strategy(), min_size=1, max_size=5), seed=st.integers(0, 2 ** 32 - 1),
+       real_matrix=st.booleans())
+def test_lower_never_exceeds_upper_many(spec, seed, real_matrix):
+    lower_never_exceeds_upper(spec, seed, real_matrix)
+
+
+def test_lower_bound_of_zero_matrix():
+    S = BlockStructure([Block.scalar(), Block.real()])
+    lo = mu_lower(np.zeros((2, 2)), S)
+    assert lo.value == 0.0 and lo.Delta is None
+    assert mu_upper(np.zeros((2, 2)), S).value == 0.0
+
+
+def test_mixed_real_complex_example():
+    # the two-mass robust-performance structure: four real parameters and a 2x2 full block
+    rng = np.random.default_rng(21)
+    S = BlockStructure([Block.real(name=n) for n in ("m1", "m2", "k1", "k2")]
+                       + [Block.full(2, 2, "performance")])
+    M = crandn(rng, 6, 6) * 0.5
+    b = mu_bounds(M, S)
+    assert b.upper.method == "lmi-dg" and b.lower.method == "real-search"
+    check_lower(M, S, b.lower)
+    check_certificate(M, S, b.upper)
+    assert b.lower.value <= b.upper.value
+    assert np.abs(b.lower.Delta[:4, :4].imag).max() == 0.0     # the parameters stay real
+    complex_ub = mu_upper(M, S, real="complex").value
+    assert b.upper.value <= complex_ub * (1 + 1e-6)
+
+
+# -- certificates and solver failure ------------------------------------------------------
+
+def test_dg_bound_rejects_invalid_scalings():
+    S = BlockStructure([Block.scalar(2), Block.full(1)])
+    M = np.ones((3, 3))
+    Dl = np.diag([1.0, 2.0, 1.0])          # diagonal D on a repeated scalar is allowed ...
+    assert dg_bound(M, S, Dl, Dl) > 0
+    with pytest.raises(ModelError, match="commute"):
+        dg_bound(M, S, np.diag([1.0, 1.0, 2.0]), np.diag([1.0, 1.0, 3.0]))   # ... d_l != d_r is not
+    with pytest.raises(ModelError, match="positive definite"):
+        dg_bound(M, S, np.diag([1.0, -1.0, 1.0]), np.diag([1.0, -1.0, 1.0]))
+    with pytest.raises(ModelError, match="block diagonal"):
+        D = np.eye(3)
+        D[0, 2] = D[2, 0] = 0.1
+        dg_bound(M, S, D, D)
+    with pytest.raises(ModelError, match="G must be zero outside the real blocks"):
+        dg_bound(M, S, np.eye(3), np.eye(3), np.eye(3))
+
+
+def test_lmi_solver_failure_is_reported(monkeypatch):
+    import cvxpy as cp
+
+    def broken(self, *args, **kwargs):
+        raise cp.error.SolverError("Solver 'CLARABEL' failed.")
+    monkeypatch.setattr(cp.Problem, "solve", broken)
+    S = BlockStructure([Block.scalar(), Block.scalar()])
+    with pytest.raises(SolverError, match="LMI solver.*osborne"):
+        mu_upper(SP_M, S, method="lmi")
+    # the independent bound still works
+    assert mu_upper(SP_M, S, method="osborne").value == pytest.approx(3.0, abs=1e-6)
+
+
+def test_certificate_survives_a_solver_returning_a_singular_d(monkeypatch):
+    # a solver answer with a singular or indefinite D block must still give a certified
+    # bound, never a wrong one
+    orig = mumod._LMIProblem.solve
+
+    def degenerate(self, beta):
+        out = orig(self, beta)
+        if isinstance(out, str):
+            return out
+        t, xd, xg = out
+        xd = xd.copy()
+        xd[0] = 0.0
+        return t, xd, xg
+    monkeypatch.setattr(mumod._LMIProblem, "solve", degenerate)
+    S = BlockStructure([Block.scalar(2), Block.full(1)])
+    M = crandn(np.random.default_rng(5), 3, 3)
+    up = mu_upper(M, S)
+    assert up.iterations > 0
+    check_certificate(M, S, up)
+    assert up.value >= mu_lower(M, S).value * (1 - 1e-12)
+    assert up.value <= mu_upper(M, S, method="osborne").value * (1 + 1e-12)
+
+
+# -- bad input ---------------------------------------------------------------------------
+
+def test_size_mismatch_names_both_sizes():
+    S = BlockStructure([Block.full(2), Block.scalar()])
+    with pytest.raises(ModelError) as exc:
+        mu_upper(np.ones((2, 2)), S)
+    assert "2x2" in str(exc.value) and "3x3" in str(exc.value)
+    S2 = BlockStructure([Block.full(2, 3)])       # Delta 2x3, so M must be 3x2
+    with pytest.raises(ModelError) as exc:
+        mu_lower(np.ones((2, 3)), S2)
+    assert "2x3" in str(exc.value) and "3x2" in str(exc.value)
+
+
+def test_bad_blocks():
+    with pytest.raises(ModelError, match="must be square"):
+        Block("scalar", 2, 3)
+    with pytest.raises(ModelError, match="must be square"):
+        Block("real", 1, 2)
+    with pytest.raises(ModelError, match="positive integer"):
+        Block.full(0)
+    with pytest.raises(ModelError, match="kind"):
+        Block("diagonal", 2, 2)
+    with pytest.raises(ModelError, match="at least one block"):
+        BlockStructure([])
+
+
+def test_nan_in_matrix():
+    S = BlockStructure([Block.scalar(), Block.scalar()])
+    M = SP_M.copy()
+    M[0, 1] = np.nan
+    for fn in (mu_upper, mu_lower):
+        with pytest.raises(ModelError, match="non-finite"):
+            fn(M, S)
+
+
+def test_unknown_options():
+    S = BlockStructure([Block.scalar(), Block.scalar()])
+    with pytest.raises(ModelError, match="method"):
+        mu_upper(SP_M, S, method="magic")
+    with pytest.raises(ModelError, match="real"):
+        mu_upper(SP_M, S, real="yes")
+
+
+# -- frequency sweeps ------------------------------------------------------------------------
+
+def two_mode_system():
+    """2x2 system with modes at 1 and 3 rad/s (zeta = 0.05 and 0.1) and a direct term."""
+    A = np.zeros((4, 4))
+    for i, (wn, z) in enumerate([(1.0, 0.05), (3.0, 0.1)]):
+        A[2 * i:2 * i + 2, 2 * i:2 * i + 2] = [[0, 1], [-wn ** 2, -2 * z * wn]]
+    B = np.array([[0, 0], [1, 0.5], [0, 0], [0.3, 1]])
+    C = np.array([[1, 0, 2, 0], [0.5, 0, -1, 0]])
+    D = np.array([[0.1, 0], [0, 0.2]])
+    return ss(A, B, C, D)
+
+
+def test_sweep_agrees_with_pointwise_bounds():
+    sys = two_mode_system()
+    S = BlockStructure([Block.scalar(), Block.scalar()])
+    omega = np.logspace(-1, 1, 40)
+    sw = mu_sweep(sys, S, omega, lower="all", refine=False)
+    assert np.array_equal(sw.omega, omega)
+    H = freqresp(sys, omega)
+    for k in range(omega.size):
+        assert sw.upper[k] == pytest.approx(mu_upper(H[:, :, k], S, method="osborne").value, rel=1e-9)
+    assert np.all(np.isfinite(sw.lower))
+    assert np.all(sw.lower <= sw.upper * (1 + 1e-9))
+    assert sw.peak_upper == pytest.approx(sw.upper.max())
+    # the LMI sweep on a few points: the same numbers as mu_upper, and no larger than Osborne
+    few = omega[::10]
+    lm = mu_sweep(sys, S, few, method="lmi", lower="all", refine=False)
+    assert lm.method == "lmi-d"
+    for k, w in enumerate(few):
+        ref = mu_upper(freqresp(sys, [w])[:, :, 0], S, method="lmi").value
+        assert lm.upper[k] == pytest.approx(ref, rel=1e-5)
+    assert np.all(lm.lower <= lm.upper * (1 + 1e-8))
+    assert np.all(lm.upper <= sw.upper[::10] * (1 + 1e-6))
+
+
+def test_sweep_finds_narrow_resonance_between_grid_points():
+    zeta, wn = 1e-4, 1.2345
+    # M(s) = g(s) N with g = wn^2 / (s^2 + 2 zeta wn s + wn^2) and the rank-one
+    # N = [2; -1] [1 1] of example 8.5, so mu(M(jw)) = 3 |g(jw)|
+    A = np.array([[0.0, 1.0], [-wn ** 2, -2 * zeta * wn]])
+    sys = ss(A, np.array([[0.0], [wn ** 2]]) @ np.array([[1.0, 1.0]]),
+             np.array([[2.0], [-1.0]]) @ np.array([[1.0, 0.0]]), np.zeros((2, 2)))
+    S = BlockStructure([Block.scalar(), Block.scalar()])
+    peak = 3.0 / (2 * zeta * np.sqrt(1 - zeta ** 2))
+    omega = np.logspace(-1, 1, 50)
+    assert np.min(np.abs(omega - wn)) > 100 * zeta * wn        # the resonance is between points
+    coarse = mu_sweep(sys, S, omega, lower="none", refine=False)
+    assert coarse.peak_upper < 0.05 * peak                      # a plain grid misses it ...
+    sw = mu_sweep(sys, S, omega, lower="peaks")
+    assert sw.peak_upper == pytest.approx(peak, rel=0.01)       # ... refinement finds it
+    assert sw.peak_frequency == pytest.approx(wn * np.sqrt(1 - 2 * zeta ** 2), rel=1e-4)
+    assert sw.peak_lower == pytest.approx(peak, rel=0.01)
+    assert sw.lower_delta is not None
+
+
+def test_sweep_refines_a_broad_peak():
+    # zeta = 0.05 on a coarse grid: the pole frequency alone is off the peak by
+    # zeta^2/2 relative, the golden-section search must find the maximum itself
+    zeta, wn = 0.05, 2.0
+    A = np.array([[0.0, 1.0], [-wn ** 2, -2 * zeta * wn]])
+    sys = ss(A, np.array([[0.0], [wn ** 2]]) @ np.array([[1.0, 1.0]]),
+             np.array([[2.0], [-1.0]]) @ np.array([[1.0, 0.0]]), np.zeros((2, 2)))
+    S = BlockStructure([Block.scalar(), Block.scalar()])
+    peak = 3.0 / (2 * zeta * np.sqrt(1 - zeta ** 2))
+    omega = np.logspace(-1, 1, 12)
+    assert mu_sweep(sys, S, omega, lower="none", refine=False).peak_upper < 0.9 * peak
+    sw = mu_sweep(sys, S, omega, lower="none")
+    assert sw.peak_upper == pytest.approx(peak, rel=1e-8)
+    assert sw.peak_frequency == pytest.approx(wn * np.sqrt(1 - 2 * zeta ** 2), rel=1e-5)
+    assert sw.peak_upper <= peak * (1 + 1e-9)
+
+
+def test_sweep_bad_input():
+    sys = two_mode_system()
+    S = BlockStructure([Block.scalar(), Block.scalar()])
+    with pytest.raises(ModelError, match="empty"):
+        mu_sweep(sys, S, [])
+    with pytest.raises(ModelError, match="non-negative"):
+        mu_sweep(sys, S, [-1.0, 2.0])
+    with pytest.raises(ModelError, match="needs 3 outputs"):
+        mu_sweep(sys, BlockStructure([Block.full(2, 3)]), [1.0])
+    with pytest.raises(ModelError, match="lower"):
+        mu_sweep(sys, S, [1.0], lower="sometimes")
+    undamped = ss([[0.0, 1.0], [-1.0, 0.0]], [[0.0], [1.0]], [[1.0, 0.0]], [[0.0]])
+    with pytest.raises(ModelError, match="imaginary axis"):
+        mu_sweep(undamped, BlockStructure([Block.scalar()]), [0.5, 1.0, 2.0])
