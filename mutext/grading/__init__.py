@@ -22,7 +22,9 @@ Integrity
 Before the submission is imported, the child installs an audit hook that
 blocks opening files of :mod:`mutext.grading` (with the reference
 solutions), :mod:`mutext.examples` and :mod:`mutext.demos` (and, in a source
-checkout, of ``.git`` and ``tests``), importing those packages, writing into
+checkout, of ``.git`` and ``tests``; for an exercise whose answer the library
+computes, also that library module, e.g. :mod:`mutext.rotor` for ex04),
+importing those packages, writing into
 the installed package, starting processes and loading native code with
 :mod:`ctypes`.
 Students may use numpy, scipy, control, :mod:`mutext.lti` and
@@ -42,6 +44,8 @@ compare
     Frequency-response comparison with feedback per channel.
 ex01_two_mass_hinf
     Grader of the first exercise.
+ex04_beam_element
+    Grader of the beam-element exercise (numpy only; :mod:`mutext.rotor` is blocked).
 solutions
     Reference solutions (each one a full-marks submission).
 """

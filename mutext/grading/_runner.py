@@ -33,6 +33,7 @@ import threading
 import traceback
 
 MAX_STATES = 400   # larger "models" are almost certainly a bug, and would bloat the channel
+MAX_ARRAY = 100_000   # entries of a returned array (kind "array")
 
 
 def _write(out, nonce, **event):
@@ -181,6 +182,30 @@ def _encode_float(value, np):
         raise TypeError(f"returned {type(value).__name__}, expected a float ({exc})") from None
 
 
+def _encode_array(value, np):
+    """Array-like of real numbers (a tuple ``(K, M)`` of equal shapes too) -> nested lists."""
+    if isinstance(value, (str, bytes, bool, dict)) or value is None:
+        raise TypeError(f"returned {type(value).__name__}, expected a numpy array of numbers")
+    try:
+        arr = np.asarray(value)
+    except Exception as exc:   # noqa: BLE001 - ragged sequences and the like
+        raise TypeError(f"returned a value that is not an array of numbers ({exc})") from None
+    if arr.dtype == object:
+        raise TypeError("returned a ragged or mixed sequence, expected a numpy array of numbers "
+                        "(are the matrices of a tuple of different sizes?)")
+    if np.iscomplexobj(arr):
+        if np.any(arr.imag != 0):
+            raise TypeError("returned complex numbers; real numbers are expected")
+        arr = arr.real
+    try:
+        arr = np.asarray(arr, dtype=float)
+    except (TypeError, ValueError) as exc:
+        raise TypeError(f"returned {arr.dtype} entries, expected numbers ({exc})") from None
+    if arr.size > MAX_ARRAY:
+        raise TypeError(f"returned an array with {arr.size} entries (more than {MAX_ARRAY})")
+    return {"shape": list(arr.shape), "data": arr.ravel().tolist()}
+
+
 def _decode_arg(a, ct):
     if isinstance(a, dict) and "__ss__" in a:
         A, B, C, D = a["__ss__"]
@@ -259,7 +284,12 @@ def main(request_path):
                     continue
                 guard.phase = None
                 try:
-                    enc = _encode_ss(value, np, ct) if kind == "ss" else _encode_float(value, np)
+                    if kind == "ss":
+                        enc = _encode_ss(value, np, ct)
+                    elif kind == "array":
+                        enc = _encode_array(value, np)
+                    else:
+                        enc = _encode_float(value, np)
                 except Exception as exc:   # noqa: BLE001 - a bad return value, not a grader bug
                     calls.append({"ok": False, "error": f"{fname}() {exc}" if str(exc).startswith("returned")
                                   else f"{fname}(): {exc}"})

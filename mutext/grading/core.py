@@ -39,7 +39,7 @@ class Question:
     function: str
     title: str
     points: float
-    kind: str                    # "ss" or "float": what the function must return
+    kind: str                    # "ss", "float" or "array": what the function must return
     calls: list
     check: Callable
 
@@ -55,6 +55,7 @@ class Exercise:
     questions: Callable          # () -> list[Question]; built lazily (references cost time)
     stub: str = ""               # path of the file students fill in, relative to the repository
     prepare: Callable | None = None   # expensive reference computations, run while the child works
+    blocked_modules: tuple = ()  # library modules that compute this exercise's answers (not importable)
 
 
 @dataclass
@@ -116,6 +117,9 @@ class Report:
 EXERCISES = {
     "ex01_two_mass_hinf": ("mutext.grading.ex01_two_mass_hinf",
                            "two-mass system: mechanical model, generalized plant, H-infinity norm, controller"),
+    "ex04_beam_element": ("mutext.grading.ex04_beam_element",
+                          "Euler-Bernoulli beam elements: element matrices, assembly, natural frequencies, "
+                          "convergence"),
 }
 
 
@@ -170,7 +174,8 @@ def grade(exercise: str, submission, time_limit: float = 60.0) -> Report:
     computed here from the plain numbers it returns.
 
     Integrity policy: an attempt to open the grader's files, to import
-    ``mutext.grading``, ``mutext.examples`` or ``mutext.demos``, to start a
+    ``mutext.grading``, ``mutext.examples`` or ``mutext.demos`` (and the
+    exercise's ``blocked_modules``, e.g. ``mutext.rotor`` for ex04), to start a
     process or to load native code with :mod:`ctypes` is blocked.  If it
     happens while a question's function runs, that question scores 0; if it
     happens at import time (module level), every question scores 0.
@@ -208,7 +213,7 @@ def grade(exercise: str, submission, time_limit: float = 60.0) -> Report:
         # the reference computations overlap with the child's run; checks wait for them
         warm = threading.Thread(target=_quietly, args=(ex.prepare,), daemon=True)
         warm.start()
-    res = run_submission(path, jobs, time_limit=time_limit)
+    res = run_submission(path, jobs, time_limit=time_limit, blocked_modules=ex.blocked_modules)
     imp = res.import_
     reports, notes = [], []
     import_violation = "; ".join(dict.fromkeys(imp.violations))

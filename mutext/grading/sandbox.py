@@ -48,7 +48,8 @@ class Job:
 
     ``calls`` is a list of ``{"args": [...], "kwargs": {...}}`` with JSON
     values; a state-space argument is ``{"__ss__": [A, B, C, D]}``.
-    ``kind`` is ``"ss"`` (return a state-space model) or ``"float"``.
+    ``kind`` is ``"ss"`` (return a state-space model), ``"float"`` or
+    ``"array"`` (an array of real numbers, e.g. a matrix or a tuple ``(K, M)``).
     """
     id: str
     function: str
@@ -138,15 +139,25 @@ class _Events:
         return out
 
 
-def _run_once(workdir, submission, jobs, time_limit, outcomes, imp, log):
+def _module_dir(name):
+    """File or directory of a ``mutext`` module or package (``"mutext.rotor"`` -> ``.../mutext/rotor``)."""
+    parts = name.split(".")
+    if parts[0] != PACKAGE_ROOT.name:
+        raise ValueError(f"only modules of {PACKAGE_ROOT.name} can be protected, got {name!r}")
+    path = PACKAGE_ROOT.joinpath(*parts[1:])
+    return path if path.is_dir() else path.with_suffix(".py")
+
+
+def _run_once(workdir, submission, jobs, time_limit, outcomes, imp, log, extra_modules=()):
     """Start one child for ``jobs``; fill ``outcomes``/``imp``; return the phase that was cut short."""
     nonce = secrets.token_hex(16)
     results = workdir / f"results-{nonce}.jsonl"
     request = workdir / f"request-{nonce}.json"
     request.write_text(json.dumps({
         "nonce": nonce, "results": str(results), "submission": str(submission),
-        "blocked_dirs": [str(d) for d in PROTECTED_DIRS], "protected_root": str(PACKAGE_ROOT),
-        "blocked_modules": PROTECTED_MODULES,
+        "blocked_dirs": [str(d) for d in PROTECTED_DIRS + [_module_dir(m) for m in extra_modules]],
+        "protected_root": str(PACKAGE_ROOT),
+        "blocked_modules": PROTECTED_MODULES + list(extra_modules),
         "jobs": [{"id": t.id, "function": t.function, "kind": t.kind, "calls": t.calls} for t in jobs],
     }))
     errpath = workdir / f"stderr-{nonce}.txt"
@@ -199,7 +210,7 @@ def _run_once(workdir, submission, jobs, time_limit, outcomes, imp, log):
     return cut
 
 
-def run_submission(submission, jobs, time_limit: float = 60.0) -> SandboxResult:
+def run_submission(submission, jobs, time_limit: float = 60.0, blocked_modules=()) -> SandboxResult:
     """Import ``submission`` in a child process and run ``jobs``.
 
     Parameters
@@ -211,6 +222,10 @@ def run_submission(submission, jobs, time_limit: float = 60.0) -> SandboxResult:
     time_limit : float
         Seconds of wall-clock time allowed for importing the submission and,
         separately, for each question.
+    blocked_modules : sequence of str
+        Further ``mutext`` modules or packages (e.g. ``"mutext.rotor"``) the
+        submission may neither import nor read, in addition to
+        :data:`PROTECTED_MODULES` (an exercise whose answer the library computes).
 
     Returns
     -------
@@ -228,7 +243,7 @@ def run_submission(submission, jobs, time_limit: float = 60.0) -> SandboxResult:
         pending = list(jobs)
         while pending:
             children += 1
-            cut = _run_once(workdir, sub, pending, time_limit, outcomes, imp, log)
+            cut = _run_once(workdir, sub, pending, time_limit, outcomes, imp, log, tuple(blocked_modules))
             if cut is not None:
                 phase, status, rc = cut
                 if phase == "startup":

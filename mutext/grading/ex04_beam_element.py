@@ -1,0 +1,621 @@
+r"""Grader of exercise ``ex04_beam_element``: Euler-Bernoulli beam elements in numpy.
+
+Questions (10 points):
+
+(a) ``element_matrices(E, I, rho, A, L)``, 3 points: the 4x4 stiffness and
+    consistent mass matrices, DOFs ``[w1, theta1, w2, theta2]``, at two
+    parameter sets (0.75 points per matrix and set).
+(b) ``assemble(n_elements, length, E, I, rho, A, support)``, 2 points: the
+    global ``(K, M)`` of a pinned-pinned and of a cantilever beam with the
+    supports applied (0.5 points per matrix and beam; half of that when the
+    matrices are right but the supports are not applied or the DOFs are in
+    another order).
+(c) ``natural_frequencies(...)``, 2 points: the lowest frequencies in rad/s
+    of two beams (1 point each).
+(d) ``relative_errors(...)``, 3 points: ``(omega_N - omega_exact)/omega_exact``
+    for N = 2, 4, 8 elements, three beams and modes (1 point each).
+
+The references are computed with :mod:`mutext.rotor` (Timoshenko shaft
+elements with shear deformation and rotary inertia switched off, which is
+the Euler-Bernoulli element) and the exact Euler-Bernoulli frequencies
+:math:`\omega_n = (\beta_n L)^2\sqrt{EI/(\rho A L^4)}`.  Submissions may not
+import :mod:`mutext.rotor` (it computes the answers).  Feedback names the
+usual mistakes: a lumped instead of a consistent mass matrix, a factor
+:math:`L` missing in the rotational terms, a wrong prefactor, another DOF
+order or rotation sign, supports not applied (rigid-body zero frequencies),
+Hz instead of rad/s, an inaccurate analytic value.
+"""
+from __future__ import annotations
+
+import functools
+import math
+import threading
+
+import numpy as np
+import scipy.linalg as sla
+
+from .compare import fmt
+from .core import Call, Exercise, Question
+
+POINTS = {"a": 3.0, "b": 2.0, "c": 2.0, "d": 3.0}
+RTOL = 1e-6            # matrices and frequencies: max |error| / max |reference|
+RTOL_ERR = 1e-4        # relative errors of (d): relative to the error itself ...
+ATOL_ERR = 1e-9        # ... plus this absolute slack (the errors reach 1e-6)
+
+#: beta_n L of the exact Euler-Bernoulli modes (pinned-pinned: n pi; clamped-free: cos x cosh x = -1)
+BETA_L = {
+    "pinned": [math.pi * n for n in range(1, 7)],
+    "cantilever": [1.8751040687119611, 4.6940911329741745, 7.8547574382376126, 10.995540734875467,
+                   14.137168391046471, 17.278759532088237],
+}
+SUPPORT_TEXT = {"pinned": "pinned-pinned", "cantilever": "cantilever"}
+
+#: materials and solid circular sections (diameter d) of the test beams, SI
+STEEL = dict(E=2.1e11, rho=7800.0, d=0.02)
+ALUMINIUM = dict(E=7.0e10, rho=2700.0, d=0.03)
+DOF_NAMES = ["w1", "theta1", "w2", "theta2"]
+ROT = np.array([0, 1, 0, 1])          # 1 where the element DOF is a rotation
+
+
+def section(d):
+    """Area and second moment of area of a solid circle of diameter ``d`` (m^2, m^4)."""
+    return math.pi * d**2 / 4.0, math.pi * d**4 / 64.0
+
+
+def beam_args(mat):
+    """``(E, I, rho, A)`` of a material dict, as the student's functions take them."""
+    A, I = section(mat["d"])
+    return mat["E"], I, mat["rho"], A
+
+
+# ----------------------------------------------------------------------------
+# references (mutext.rotor and analytic)
+# ----------------------------------------------------------------------------
+
+def element_reference(E, d, rho, L):
+    """``(K, Mt, Mr)`` of one element from :mod:`mutext.rotor` without shear (Euler-Bernoulli)."""
+    from ..rotor.elements import timoshenko_plane_matrices
+    Mt, Mr, K = timoshenko_plane_matrices(E, E / 2.6, rho, L, d, 0.0, 1.0, shear=False)
+    return tuple(np.asarray(X.full() if hasattr(X, "full") else X, dtype=float) for X in (K, Mt, Mr))
+
+
+def _free_free(n, length, E, d, rho):
+    """Global ``(K, M)`` of ``n`` Euler-Bernoulli elements, no supports, from a :class:`mutext.rotor.Rotor`."""
+    from ..rotor import Param, Rotor, ShaftElement
+    mat = dict(E=Param("E", E), rho=Param("rho", rho), nu=Param("nu", 0.3))
+    els = [ShaftElement(i + 1, length / n, d, 0.0, **mat, shear=False, rotary_inertia=False) for i in range(n)]
+    M, _, K, _ = Rotor(els, planes=1).matrices()      # plane layout (u, psi), psi = du/dz: (w, theta)
+    return K, M
+
+
+_LOCK = threading.Lock()
+
+
+@functools.lru_cache(maxsize=64)
+def _free_free_cached(n, length, E, d, rho):
+    return _free_free(n, length, E, d, rho)
+
+
+def free_free(n, length, E, d, rho):
+    with _LOCK:
+        K, M = _free_free_cached(n, length, E, d, rho)
+    return K.copy(), M.copy()
+
+
+def constrained(n, support):
+    """0-based global DOFs fixed by the supports (order ``w1, theta1, w2, theta2, ...``)."""
+    return [0, 2 * n] if support == "pinned" else [0, 1]
+
+
+def reduce(K, M, fixed):
+    free = np.setdiff1d(np.arange(K.shape[0]), fixed)
+    return K[np.ix_(free, free)], M[np.ix_(free, free)]
+
+
+def supported(n, length, E, d, rho, support):
+    return reduce(*free_free(n, length, E, d, rho), constrained(n, support))
+
+
+def frequencies(K, M, n_modes=None):
+    """Natural frequencies (rad/s) of ``(K, M)``, ascending; massless DOFs (lumped mass) are condensed out."""
+    if np.all(np.linalg.eigvalsh(M) > 1e-12 * np.abs(M).max()):
+        lam = sla.eigh(K, M, eigvals_only=True)
+    else:
+        lam = sla.eigvals(K, M)
+        lam = np.sort(lam[np.isfinite(lam)].real)
+    w = np.sqrt(np.maximum(lam, 0.0))
+    return w if n_modes is None else w[:n_modes]
+
+
+def exact_frequency(length, E, d, rho, support, mode):
+    """Exact Euler-Bernoulli frequency [rad/s] of mode ``mode`` (1-based)."""
+    A, I = section(d)
+    return BETA_L[support][mode - 1] ** 2 * math.sqrt(E * I / (rho * A * length**4))
+
+
+def reference_errors(length, E, d, rho, support, mode):
+    exact = exact_frequency(length, E, d, rho, support, mode)
+    return np.array([frequencies(*supported(n, length, E, d, rho, support))[mode - 1] / exact - 1.0
+                     for n in (2, 4, 8)])
+
+
+def _lumped_free_free(n, length, E, d, rho):
+    K, _ = free_free(n, length, E, d, rho)
+    A, _ = section(d)
+    m = rho * A * length / n
+    M = np.zeros_like(K)
+    for e in range(n):
+        M[2 * e, 2 * e] += m / 2
+        M[2 * e + 2, 2 * e + 2] += m / 2
+    return K, M
+
+
+def prepare():
+    """Build the references of all calls (the CasADi models) while the child runs."""
+    for n, length, mat in ((3, 1.2, STEEL), (4, 0.8, ALUMINIUM), (4, 1.2, STEEL), (5, 0.8, ALUMINIUM),
+                           (2, 1.2, STEEL), (8, 1.2, STEEL), (2, 0.8, ALUMINIUM), (8, 0.8, ALUMINIUM)):
+        free_free(n, length, mat["E"], mat["d"], mat["rho"])
+
+
+# ----------------------------------------------------------------------------
+# helpers
+# ----------------------------------------------------------------------------
+
+def _array(value, what):
+    """The child's ``{"shape", "data"}`` as an ndarray, or ``(None, message)``."""
+    try:
+        return np.asarray(value["data"], dtype=float).reshape(value["shape"]), None
+    except Exception as exc:   # noqa: BLE001 - malformed payload is the submission's fault
+        return None, f"{what}: the returned value is not an array of numbers ({exc})"
+
+
+def close(X, Y, rtol=RTOL):
+    """Same shape and ``max|X - Y| <= rtol max|Y|`` (False on NaN)."""
+    if X.shape != Y.shape:
+        return False
+    with np.errstate(invalid="ignore"):
+        return bool(np.all(np.abs(X - Y) <= rtol * max(np.abs(Y).max(), 1e-300)))
+
+
+def _factor(X, Y):
+    """``c`` with ``X = c Y`` (to ``RTOL``), else None."""
+    den = float(np.sum(Y * Y))
+    if X.shape != Y.shape or den == 0 or not np.all(np.isfinite(X)):
+        return None
+    c = float(np.sum(X * Y)) / den
+    return c if c != 0 and close(X, c * Y) else None
+
+
+def _power_of(c, L, kmax=3):
+    """Integer ``k != 0`` with ``c = L^k`` (to 1e-6), else None."""
+    for k in range(-kmax, kmax + 1):
+        if k and abs(c / L**k - 1.0) <= 1e-6:
+            return k
+    return None
+
+
+def _rotation_pattern(X, Y, L):
+    r"""``(c, p)`` if ``X_ij = c L^{p (r_i + r_j)} Y_ij`` (``r`` = 1 on rotations), ``p != 0``; else None."""
+    if X.shape != (4, 4) or not np.all(np.isfinite(X)):
+        return None
+    nz = np.abs(Y) > 1e-12 * np.abs(Y).max()
+    r = (ROT[:, None] + ROT[None, :])[nz]
+    R = X[nz] / Y[nz]
+    groups = [R[r == k] for k in (0, 1, 2)]
+    if any(g.size == 0 for g in groups):
+        return None
+    means = [float(np.mean(g)) for g in groups]
+    if any(m == 0 or np.any(np.abs(g - m) > 1e-6 * abs(m)) for g, m in zip(groups, means)):
+        return None
+    q1, q2 = means[1] / means[0], means[2] / means[0]
+    if q1 <= 0 or abs(q2 / q1**2 - 1) > 1e-6:
+        return None
+    p = math.log(q1) / math.log(L)
+    if abs(p - round(p)) > 1e-6 or round(p) == 0:
+        return None
+    return means[0], int(round(p))
+
+
+def _worst_entry(X, Y, names):
+    err = np.abs(X - Y)
+    i, j = np.unravel_index(int(np.nanargmax(np.where(np.isfinite(err), err, np.inf))), X.shape)
+    return f"entry ({names[i]}, {names[j]}): expected {fmt(Y[i, j])}, got {fmt(X[i, j])}"
+
+
+def _power_text(k):
+    return "L" if k == 1 else f"L^{k}"
+
+
+# ----------------------------------------------------------------------------
+# (a) element matrices
+# ----------------------------------------------------------------------------
+
+PERM = [0, 2, 1, 3]                     # [w1, w2, theta1, theta2]
+SIGN = np.diag([1.0, -1.0, 1.0, -1.0])  # theta = -dw/dz
+
+
+def _diagnose_element(X, Y, L, which, Mr=None):
+    """Why the submitted element matrix ``X`` differs from ``Y`` (``which`` is "K" or "M")."""
+    name = "stiffness matrix K" if which == "K" else "mass matrix M"
+    pref = "EI/L^3" if which == "K" else "rho A L/420"
+    if X.shape != (4, 4):
+        return f"the {name} must be 4x4 (DOFs [w1, theta1, w2, theta2]), got shape {X.shape}"
+    if not np.all(np.isfinite(X)):
+        return f"the {name} has entries that are not finite"
+    if which == "M":
+        off = X - np.diag(np.diag(X))
+        if np.all(np.abs(off) <= 1e-12 * max(np.abs(X).max(), 1e-300)):
+            return ("the mass matrix is lumped, not consistent: it is diagonal. The consistent mass matrix "
+                    "M = rho A L/420 [156, 22L, 54, -13L; ...] comes from the same cubic shape functions as K "
+                    "and couples all four DOFs")
+        if Mr is not None and close(X, Y + Mr):
+            return ("the mass matrix includes the rotary inertia rho I (a Rayleigh beam); the Euler-Bernoulli "
+                    "element here has translational inertia rho A only")
+    if close(X, Y[np.ix_(PERM, PERM)]):
+        return (f"the {name} has its DOFs in the order [w1, w2, theta1, theta2]; the expected order is "
+                "[w1, theta1, w2, theta2] (node by node)")
+    if close(X, SIGN @ Y @ SIGN):
+        return (f"the {name} has the signs of the deflection-rotation coupling terms flipped: "
+                "theta is dw/dz (counterclockwise positive), not -dw/dz")
+    c = _factor(X, Y)
+    if c is not None:
+        k = _power_of(c, L)
+        if k is not None:
+            extra = (f" (e.g. EI/L^{3 - k} instead of EI/L^3)" if which == "K"
+                     else f" (e.g. rho A L^{1 + k}/420 instead of rho A L/420)")
+            return (f"the {name} is {_power_text(k)} times the expected one: check the power of L in the "
+                    f"prefactor {pref}{extra}")
+        return f"the {name} is {fmt(c)} times the expected one: check the prefactor {pref}"
+    pat = _rotation_pattern(X, Y, L)
+    if pat is not None:
+        c, p = pat
+        terms = "6L, 4L^2, 2L^2" if which == "K" else "22L, 13L, 4L^2, 3L^2"
+        if p < 0:
+            msg = (f"a factor {_power_text(-p)} is missing in the rotational terms of the {name} "
+                   f"(the entries of the theta rows and columns: {terms})")
+        else:
+            msg = (f"the rotational terms of the {name} have an extra factor {_power_text(p)} "
+                   f"(the entries of the theta rows and columns should be {terms})")
+        if abs(c - 1) > 1e-6:
+            msg += f"; moreover the prefactor is {fmt(c)} times {pref}"
+        return msg
+    fb = f"the {name} differs from the expected one: {_worst_entry(X, Y, DOF_NAMES)}"
+    if not close(X, X.T):
+        fb += f"; note that your {name} is not symmetric"
+    return fb
+
+
+def _check_element(outcomes, calls):
+    per = POINTS["a"] / (2 * len(calls))
+    score, fb, n_ok = 0.0, [], 0
+    for call, oc in zip(calls, outcomes):
+        tag = f"[{call.label}]"
+        if not oc["ok"]:
+            fb.append(f"{tag} {oc['error']}")
+            continue
+        V, err = _array(oc["value"], "element_matrices()")
+        if err:
+            fb.append(f"{tag} {err}")
+            continue
+        if V.shape != (2, 4, 4):
+            fb.append(f"{tag} element_matrices() must return the pair (K, M) of 4x4 arrays, got an array of "
+                      f"shape {V.shape}")
+            continue
+        E, I, rho, A, L = call.args
+        K, Mt, Mr = element_reference(E, call.kwargs_ref["d"], rho, L)
+        Ks, Ms = V
+        if close(Ks, Mt) and close(Ms, K):
+            fb.append(f"{tag} K and M are swapped: return (K, M)")
+            continue
+        for X, Y, which in ((Ks, K, "K"), (Ms, Mt, "M")):
+            if close(X, Y):
+                score += per
+                n_ok += 1
+            else:
+                fb.append(f"{tag} " + _diagnose_element(X, Y, L, which, Mr))
+    if n_ok == 2 * len(calls):
+        fb.insert(0, "correct: K and M match at both parameter sets")
+    return score, fb
+
+
+# ----------------------------------------------------------------------------
+# (b) assembly
+# ----------------------------------------------------------------------------
+
+def _same_spectrum(Ks, Ms, K, M):
+    try:
+        a = frequencies(Ks, Ms)
+    except Exception:   # noqa: BLE001 - a singular or indefinite submitted mass matrix
+        return False
+    return close(a, frequencies(K, M))
+
+
+def _check_assembly(outcomes, calls):
+    per = POINTS["b"] / (2 * len(calls))
+    score, fb, n_ok = 0.0, [], 0
+    for call, oc in zip(calls, outcomes):
+        tag = f"[{call.label}]"
+        if not oc["ok"]:
+            fb.append(f"{tag} {oc['error']}")
+            continue
+        V, err = _array(oc["value"], "assemble()")
+        if err:
+            fb.append(f"{tag} {err}")
+            continue
+        n, length, E, I, rho, A, support = call.args
+        d = call.kwargs_ref["d"]
+        if V.ndim != 3 or V.shape[0] != 2 or V.shape[1] != V.shape[2]:
+            fb.append(f"{tag} assemble() must return the pair (K, M) of square arrays, got an array of shape "
+                      f"{V.shape}")
+            continue
+        Ks, Ms = V
+        K, M = supported(n, length, E, d, rho, support)
+        size = Ks.shape[0]
+        fixed = constrained(n, support)
+        if close(Ks, K) and close(Ms, M):
+            score += 2 * per
+            n_ok += 2
+            continue
+        if size == 2 * (n + 1):
+            K0, M0 = free_free(n, length, E, d, rho)
+            got = [close(Ks, K0), close(Ms, M0)]
+            score += 0.5 * per * sum(got)
+            fb.append(f"{tag} boundary conditions not applied: the matrices are {size}x{size}, those of the free "
+                      f"beam; remove the rows and columns of the DOFs the supports fix "
+                      f"({', '.join(_global_name(k) for k in fixed)} for a {SUPPORT_TEXT[support]} beam), "
+                      f"leaving {2 * n}x{2 * n}" + ("" if all(got) else
+                                                    "; the free-beam matrices are not right either"))
+            continue
+        if size in (4 * n, 4 * n - 2):
+            fb.append(f"{tag} the matrices are {size}x{size}: the elements look unconnected. Neighbouring "
+                      "elements share a node: add each element's 4x4 matrix into the global rows and columns "
+                      "[2e, 2e+1, 2e+2, 2e+3] (e = 0, 1, ...), so the shared 2x2 blocks overlap")
+            continue
+        if size != 2 * n:
+            fb.append(f"{tag} expected {2 * n}x{2 * n} matrices ({n} elements, {2 * (n + 1)} DOFs, "
+                      f"{len(fixed)} fixed by the supports), got {size}x{size}")
+            continue
+        other = "cantilever" if support == "pinned" else "pinned"
+        alternatives = [
+            (supported(n, length, E, d, rho, other), f"these are the matrices of a {SUPPORT_TEXT[other]} beam; "
+                                                     f"this call asks for a {SUPPORT_TEXT[support]} beam"),
+            (reduce(*free_free(n, length, E, d, rho), [2 * n, 2 * n + 1]),
+             "the beam is clamped at z = length; the cantilever is clamped at node 1 (z = 0): fix w1 and theta1"),
+            (supported(n, length * n, E, d, rho, support),
+             f"every element has the full length {length:g} m: an element is length/n_elements long"),
+        ]
+        hint = None
+        for (Ka, Ma), text in alternatives:
+            if close(Ks, Ka) and close(Ms, Ma):
+                hint = text
+                break
+        if hint is None and _same_spectrum(Ks, Ms, K, M):
+            score += per          # right beam, other DOF order: half the points
+            hint = ("the matrices have the right natural frequencies but the DOFs are in another order; expected "
+                    "w1, theta1, w2, theta2, ... (node by node) with the fixed DOFs removed")
+        if hint is not None:
+            fb.append(f"{tag} {hint}")
+            continue
+        for X, Y, which in ((Ks, K, "K"), (Ms, M, "M")):
+            if close(X, Y):
+                score += per
+                n_ok += 1
+            else:
+                names = [_global_name(k) for k in np.setdiff1d(np.arange(2 * (n + 1)), fixed)]
+                fb.append(f"{tag} {which} differs: {_worst_entry(X, Y, names)}; check the element matrices of (a) "
+                          "and that overlapping entries are added")
+    if n_ok == 2 * len(calls):
+        fb.insert(0, "correct: K and M of both beams match")
+    return score, fb
+
+
+def _global_name(k):
+    return f"{'theta' if k % 2 else 'w'}{k // 2 + 1}"
+
+
+# ----------------------------------------------------------------------------
+# (c) natural frequencies
+# ----------------------------------------------------------------------------
+
+def _check_frequencies(outcomes, calls):
+    per = POINTS["c"] / len(calls)
+    score, fb, n_ok = 0.0, [], 0
+    for call, oc in zip(calls, outcomes):
+        tag = f"[{call.label}]"
+        if not oc["ok"]:
+            fb.append(f"{tag} {oc['error']}")
+            continue
+        w, err = _array(oc["value"], "natural_frequencies()")
+        if err:
+            fb.append(f"{tag} {err}")
+            continue
+        n, length, E, I, rho, A, support, n_modes = call.args
+        d = call.kwargs_ref["d"]
+        ref = frequencies(*supported(n, length, E, d, rho, support), n_modes)
+        w = w.ravel()
+        if w.size != n_modes:
+            fb.append(f"{tag} expected the {n_modes} lowest frequencies, got {w.size} numbers")
+            continue
+        if close(w, ref):
+            score += per
+            n_ok += 1
+            continue
+        msg = None
+        K0, M0 = free_free(n, length, E, d, rho)
+        if (np.any(~np.isfinite(w)) or np.nanmin(np.abs(w)) < 1e-3 * ref[0]
+                or close(w, frequencies(K0, M0, n_modes))):
+            msg = ("boundary conditions not applied: you have rigid-body zero frequencies (a free beam has two "
+                   "rigid-body modes, at 0 rad/s; rounding turns them into tiny or NaN values)")
+        elif close(np.sort(w), ref):
+            msg = "the right frequencies, but not in ascending order"
+        elif close(w * 2 * np.pi, ref):
+            msg = "these are in Hz: return rad/s (omega = 2 pi f)"
+        elif close(w, ref**2):
+            msg = "these are omega^2 (the eigenvalues): take the square root"
+        else:
+            other = "cantilever" if support == "pinned" else "pinned"
+            alternatives = [
+                (frequencies(*reduce(*_lumped_free_free(n, length, E, d, rho), constrained(n, support)), n_modes),
+                 "these are the frequencies of a lumped mass matrix; use the consistent mass matrix of (a)"),
+                (frequencies(*supported(n, length, E, d, rho, other), n_modes),
+                 f"these are the frequencies of a {SUPPORT_TEXT[other]} beam"),
+                (frequencies(*supported(n, length * n, E, d, rho, support), n_modes),
+                 "every element has the full beam length: an element is length/n_elements long"),
+            ]
+            for alt, text in alternatives:
+                if close(w, alt):
+                    msg = text
+                    break
+        if msg is None:
+            k = int(np.nanargmax(np.abs(w - ref) / ref))
+            msg = (f"mode {k + 1}: expected {ref[k]:.6g} rad/s, got {fmt(w[k])} rad/s; check (a) and (b) "
+                   "(use scipy.linalg.eigh(K, M))")
+        fb.append(f"{tag} {msg}; expected {', '.join(f'{x:.5g}' for x in ref)} rad/s")
+    if n_ok == len(calls):
+        fb.insert(0, "correct: the frequencies of both beams match")
+    return score, fb
+
+
+# ----------------------------------------------------------------------------
+# (d) convergence
+# ----------------------------------------------------------------------------
+
+def _errors_match(e, ref):
+    return e.shape == ref.shape and bool(np.all(np.abs(e - ref) <= RTOL_ERR * np.abs(ref) + ATOL_ERR))
+
+
+def _diagnose_errors(e, ref, length, E, d, rho, support, mode):
+    exact = exact_frequency(length, E, d, rho, support, mode)
+    w_fe = exact * (1 + ref)
+    if np.all(np.isfinite(e)) and np.all(np.abs(e + 1) < 1e-3):
+        return ("your finite-element frequency is (nearly) zero: a rigid-body mode, so the boundary conditions "
+                "are not applied (see (c))")
+    if _errors_match(e, 100 * ref):
+        return "these are percentages: return the relative error as a fraction (0.01, not 1 %)"
+    if _errors_match(e, -ref / (1 + ref)):
+        return "the error has the wrong reference: return (omega_N - omega_exact) / omega_exact"
+    if _errors_match(e, w_fe - exact):
+        return "this is the absolute error in rad/s: divide by the exact frequency"
+    lumped = np.array([frequencies(*reduce(*_lumped_free_free(n, length, E, d, rho), constrained(n, support)))
+                       [mode - 1] / exact - 1 for n in (2, 4, 8)])
+    if _errors_match(e, lumped):
+        return "these are the errors of a lumped mass matrix; use the consistent mass matrix of (a)"
+    if np.all(np.isfinite(e)) and np.all(e != -1):
+        # the submission's exact value, assuming its finite-element frequencies are right
+        r = (1 + ref) / (1 + e)
+        if np.all(np.abs(r / r[0] - 1) < 1e-6):
+            c = float(r[0])               # omega_exact(submission) / omega_exact
+            bl = BETA_L[support]
+            if abs(c * 2 * np.pi - 1) < 1e-4 or abs(c / (2 * np.pi) - 1) < 1e-4:
+                return ("the finite-element and the analytic frequency are in different units (one in Hz, "
+                        "one in rad/s)")
+            if support == "cantilever" and abs(c - (math.pi * mode / bl[mode - 1]) ** 2) < 1e-4:
+                npi = "pi" if mode == 1 else f"{mode} pi"
+                return (f"the analytic value uses beta L = {npi}, which is the pinned-pinned value; for a "
+                        f"cantilever beta_{mode} L = {bl[mode - 1]:.10f} (a root of cos x cosh x = -1)")
+            for m in (mode - 1, mode + 1):
+                if 1 <= m <= len(bl) and abs(c - (bl[m - 1] / bl[mode - 1]) ** 2) < 1e-4:
+                    return (f"the analytic value is that of mode {m}, not mode {mode} "
+                            "(mode numbers start at 1; Python indices at 0)")
+            if abs(c - 1) < 1e-2:
+                return (f"your analytic frequency is {abs(c - 1) * 1e6:.3g} ppm off: use beta L to at least 10 "
+                        f"digits (beta_{mode} L = {bl[mode - 1]:.12g}); with 8 elements the finite-element error "
+                        f"is only {ref[-1]:.2g}")
+            return f"your analytic frequency is {fmt(c)} times the exact one, (beta L)^2 sqrt(EI/(rho A L^4))"
+        if np.all(np.abs(e) < np.abs(ref) * 1e-3 + 1e-12):
+            return "the errors are (nearly) zero: compare the finite-element value with the exact formula"
+        if np.all(e < 0):
+            return ("the errors are negative, but with the consistent mass matrix the finite-element frequencies "
+                    "lie above the exact ones (a Rayleigh-Ritz upper bound); a lumped mass matrix or a wrong "
+                    "analytic value gives negative errors")
+    k = int(np.argmax(np.abs(e - ref) / (np.abs(ref) + ATOL_ERR)))
+    return (f"N = {(2, 4, 8)[k]}: expected {ref[k]:.6g}, got {fmt(e[k])}; the finite-element frequencies "
+            "(see (c)) or the analytic value are off")
+
+
+def _check_errors(outcomes, calls):
+    per = POINTS["d"] / len(calls)
+    score, fb, n_ok = 0.0, [], 0
+    for call, oc in zip(calls, outcomes):
+        tag = f"[{call.label}]"
+        if not oc["ok"]:
+            fb.append(f"{tag} {oc['error']}")
+            continue
+        e, err = _array(oc["value"], "relative_errors()")
+        if err:
+            fb.append(f"{tag} {err}")
+            continue
+        length, E, I, rho, A, support = call.args
+        mode = call.kwargs["mode"]
+        d = call.kwargs_ref["d"]
+        ref = reference_errors(length, E, d, rho, support, mode)
+        e = e.ravel()
+        if e.size != 3:
+            fb.append(f"{tag} expected 3 relative errors (N = 2, 4, 8), got {e.size} numbers")
+            continue
+        if _errors_match(e, ref):
+            score += per
+            n_ok += 1
+            continue
+        fb.append(f"{tag} " + _diagnose_errors(e, ref, length, E, d, rho, support, mode)
+                  + f"; expected {', '.join(f'{x:.4g}' for x in ref)}")
+    if n_ok == len(calls):
+        rates = []
+        for call in calls:
+            length, E, I, rho, A, support = call.args
+            ref = reference_errors(length, E, call.kwargs_ref["d"], rho, support, call.kwargs["mode"])
+            rates.append(ref[:-1] / ref[1:])
+        fb.insert(0, "correct: all errors match; each halving of the elements divides the error by about "
+                     f"{np.median(np.concatenate(rates)):.0f} (h^4 convergence of cubic elements)")
+    return score, fb
+
+
+# ----------------------------------------------------------------------------
+
+class _Call(Call):
+    """A :class:`Call` that also remembers the section diameter for the reference (not sent to the child)."""
+
+    def __init__(self, label, args=(), kwargs=None, d=None):
+        super().__init__(label, list(args), dict(kwargs or {}))
+        self.kwargs_ref = {"d": d}
+
+
+def _beam_call(label, n, length, mat, support, *extra, kwargs=None):
+    E, I, rho, A = beam_args(mat)
+    args = ([n] if n is not None else []) + [length, E, I, rho, A, support, *extra]
+    return _Call(label, args, kwargs, d=mat["d"])
+
+
+def questions():
+    """The four questions with their test inputs."""
+    a_calls = []
+    for label, mat, L in (("steel, d = 20 mm, L = 0.3 m", STEEL, 0.3),
+                          ("aluminium, d = 30 mm, L = 2.5 m", ALUMINIUM, 2.5)):
+        E, I, rho, A = beam_args(mat)
+        a_calls.append(_Call(label, [E, I, rho, A, L], d=mat["d"]))
+    b_calls = [_beam_call("pinned-pinned steel beam, 1.2 m, 3 elements", 3, 1.2, STEEL, "pinned"),
+               _beam_call("cantilever aluminium beam, 0.8 m, 4 elements", 4, 0.8, ALUMINIUM, "cantilever")]
+    c_calls = [_beam_call("pinned-pinned steel beam, 1.2 m, 4 elements, 3 modes", 4, 1.2, STEEL, "pinned", 3),
+               _beam_call("cantilever aluminium beam, 0.8 m, 5 elements, 4 modes", 5, 0.8, ALUMINIUM,
+                          "cantilever", 4)]
+    d_calls = [_beam_call("pinned-pinned steel beam, 1.2 m, mode 1", None, 1.2, STEEL, "pinned",
+                          kwargs={"mode": 1}),
+               _beam_call("cantilever aluminium beam, 0.8 m, mode 1", None, 0.8, ALUMINIUM, "cantilever",
+                          kwargs={"mode": 1}),
+               _beam_call("cantilever steel beam, 1.2 m, mode 2", None, 1.2, STEEL, "cantilever",
+                          kwargs={"mode": 2})]
+    return [
+        Question("a", "element_matrices", "element stiffness and consistent mass matrices", POINTS["a"], "array",
+                 a_calls, lambda oc: _check_element(oc, a_calls)),
+        Question("b", "assemble", "global matrices with supports", POINTS["b"], "array", b_calls,
+                 lambda oc: _check_assembly(oc, b_calls)),
+        Question("c", "natural_frequencies", "natural frequencies in rad/s", POINTS["c"], "array", c_calls,
+                 lambda oc: _check_frequencies(oc, c_calls)),
+        Question("d", "relative_errors", "convergence against the exact frequency", POINTS["d"], "array",
+                 d_calls, lambda oc: _check_errors(oc, d_calls)),
+    ]
+
+
+EXERCISE = Exercise("ex04_beam_element", "Euler-Bernoulli beam elements: assembly, frequencies, convergence",
+                    questions, stub="exercises/ex04_beam_element.py", prepare=prepare,
+                    blocked_modules=("mutext.rotor",))
