@@ -16,6 +16,12 @@ model
     TOML model files for rotors and lumped chains.
 analysis
     Natural frequencies, mode shapes, whirl, Campbell data, FRFs, state space.
+reduction
+    Modal truncation with static correction and balanced truncation, with
+    the measured error (H-infinity norm, band error) and the a-priori bound.
+tuning
+    Fitting parameters to measured FRFs (IPOPT through CasADi, exact
+    sensitivities, uncertainties).
 demo
     ``mutext demo rotor``.
 
@@ -34,6 +40,8 @@ from .assembly import (Matrices, ModalDamping, ProportionalDamping, Rotor, Shaft
 from .elements import (BearingElement, Damper, DiskElement, Element, ExciterElement, InputPort, Layout,
                        OutputPort, Param, PointMass, ShaftElement, Spring)
 from .model import load_model, loads_model, rotor_from_table
+from .reduction import Reduction, balanced_truncation, hankel_singular_values, modal_truncation, reduction_error
+from .tuning import FRFSensitivity, TuneResult, frf_sensitivity, model_response, tune
 from .table import Station, StationTable, parse_station_table, read_station_table
 
 __all__ = [
@@ -42,6 +50,8 @@ __all__ = [
     "ExciterElement", "InputPort", "Layout", "OutputPort", "Param", "PointMass", "ShaftElement", "Spring",
     "load_model", "loads_model", "rotor_from_table", "Station", "StationTable", "parse_station_table",
     "read_station_table", "data_path",
+    "Reduction", "balanced_truncation", "hankel_singular_values", "modal_truncation", "reduction_error",
+    "FRFSensitivity", "TuneResult", "frf_sensitivity", "model_response", "tune",
 ]
 
 
