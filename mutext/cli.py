@@ -11,6 +11,10 @@ from .errors import MutextError
 DEMOS = {
     "two-mass-hinf": ("mutext.demos.two_mass_hinf",
                       "two-mass H-infinity control (thesis sec. 2.3.1): gamma by LMI vs slycot, checked controller"),
+    "two-mass-mu": ("mutext.demos.two_mass_mu",
+                    "two-mass mu-synthesis, +/-2 % on m1, m2, k1, k2 (thesis sec. 2.3.2): D-K iteration, checked controller"),
+    "three-mass": ("mutext.demos.three_mass",
+                   "model-based identification on the three-mass rig (thesis sec. 3.4): unmodeled dynamics as a mu-controller"),
     "rotor": ("mutext.rotor.demo",
               "rotor finite-element model: natural frequencies of the healthy and cracked rotor, exciter FRF"),
 }

@@ -13,7 +13,7 @@ import numpy as np
 from .lti import as_ss, freqresp, sigma_max
 
 __all__ = ["frequency_grid", "bode_mag", "bode_phase", "sigma_plot", "closed_loop_figure",
-           "controller_figure", "sigma_figure", "two_mass_hinf_figures"]
+           "controller_figure", "sigma_figure", "two_mass_hinf_figures", "mbi_figure"]
 
 
 def _plt():
@@ -254,3 +254,72 @@ def two_mass_hinf_figures(res, P, outdir) -> list[str]:
         plt.close(fig)
         files.append(path)
     return files
+
+
+def mbi_figure(result, true_systems, Du=None, title=None):
+    r"""Model-based identification at a glance (thesis Figs. 3.13-3.15 analogues).
+
+    Three panels: (a) the measured response of the true systems (one line per
+    sample of the uncertainty set), the engineering model and the controlled
+    engineering model; (b) the identified dynamics :math:`K` against the known
+    difference :math:`D_u` (magnitude and phase), with the identifiable band
+    shaded; (c) the error :math:`|x_t - x_e|` of the controlled model for every
+    true system, against the accepted bound :math:`W_z`.
+
+    Parameters
+    ----------
+    result : mutext.mbi.MBIResult
+    true_systems : sequence of control.StateSpace
+        Samples of the true system (inputs/outputs named as in the plant).
+    Du : dict, optional
+        Known difference ``{"dm", "dc", "dk"}`` to draw beside ``K``.
+    title : str, optional
+    """
+    from .mbi import impedance_response
+    plt = _plt()
+    w = result.omega
+    pr = result.plant.ports
+    E = result.plant.engineering
+    ie, oe = list(E.input_labels).index(pr["excitation"]), list(E.output_labels).index(pr["measurement"])
+    fig, ax = plt.subplots(2, 2, figsize=(10, 7))
+    a = ax[0, 0]
+    for k, T in enumerate(true_systems):
+        T = as_ss(T)
+        i, o = list(T.input_labels).index(pr["excitation"]), list(T.output_labels).index(pr["measurement"])
+        a.loglog(w, np.abs(freqresp(T, w)[o, i]), color="0.6", lw=2.5, label="true system" if k == 0 else None)
+    a.loglog(w, np.abs(freqresp(E, w)[oe, ie]), "C1--", label="engineering model")
+    a.loglog(w, np.abs(freqresp(result.controlled, w)[0, 0]), "C0", lw=1, label="with identified K")
+    a.set_ylabel(f"|{pr['measurement']}/{pr['excitation']}|")
+    a.set_title("(a) responses")
+    a.legend(fontsize=8)
+    Kj = freqresp(result.K, w)[0, 0]
+    lo, hi = result.fit.band
+    for a, part in ((ax[0, 1], "mag"), (ax[1, 0], "phase")):
+        a.axvspan(lo, hi, color="C2", alpha=0.1, label="identifiable band")
+        if part == "mag":
+            a.loglog(w, np.abs(Kj), "C0", label="K")
+            if Du is not None:
+                a.loglog(w, np.abs(impedance_response(Du, w)), "k:", label="$D_u$")
+            a.set_ylabel("|K| [N/m]")
+            a.set_title("(b) identified dynamics")
+            a.legend(fontsize=8)
+        else:
+            a.semilogx(w, np.degrees(np.unwrap(np.angle(Kj))), "C0", label="K")
+            if Du is not None:
+                a.semilogx(w, np.degrees(np.unwrap(np.angle(impedance_response(Du, w)))), "k:", label="$D_u$")
+            a.set_ylabel("phase [deg]")
+            a.set_title("(c) phase of K and $D_u$")
+    a = ax[1, 1]
+    for k, T in enumerate(true_systems):
+        a.loglog(w, result.error(T), color="C0", alpha=0.6, lw=1, label="true samples" if k == 0 else None)
+    a.axhline(result.Wz, color="C3", ls="--", label=f"$W_z$ = {result.Wz:.3g}")
+    a.set_ylabel(r"$|x_t - x_e|$ per unit input")
+    a.set_title("(d) error of the controlled model")
+    a.legend(fontsize=8)
+    for a in ax.ravel():
+        a.set_xlabel("frequency [rad/s]")
+        a.grid(True, which="both", alpha=0.3)
+    if title:
+        fig.suptitle(title)
+    fig.tight_layout()
+    return fig

@@ -114,3 +114,27 @@ def _trials():
 
 #: Trials 1a-5 with the thesis's guessed (engineering) and true values.
 TRIALS = _trials()
+
+
+def _changed(trial: Trial):
+    """Names of the cart-3 parameters that differ between the engineering and true rigs."""
+    return [n for n in ("m3", "c3", "k3") if getattr(trial.engineering, n) != getattr(trial.true, n)]
+
+
+def true_model(trial: Trial):
+    """The true rig as an uncertain model: each changed parameter known to
+    ``trial.uncertainty`` (relative), inputs ``f1, f3``, outputs ``x1, x3``
+    after the uncertainty channels."""
+    from dataclasses import replace as _replace
+    from ..uncertain import UncertainParameter, uncertain_mck
+    params = [UncertainParameter(n, getattr(trial.true, n), rel=trial.uncertainty) for n in _changed(trial)]
+    return uncertain_mck(lambda v: matrices(_replace(trial.true, **v)), params,
+                         inputs={"f1": 0, "f3": 2}, outputs={"x1": 0, "x3": 2},
+                         dof_names=["x1", "x2", "x3"])
+
+
+def mbi_arguments(trial: Trial) -> dict:
+    """Keyword arguments of :func:`mutext.mbi.identify` for a trial (excitation and
+    measurement at cart 1, the unknown dynamics at cart 3, unit excitation force)."""
+    return dict(true=true_model(trial), engineering=mechanical_model(trial.engineering),
+                excitation="f1", measurement="x1", control_input="f3", control_output="x3", Ww=1.0)

@@ -1,0 +1,576 @@
+r"""Model-based identification by mu-synthesis (thesis ch. 3).
+
+A *true* system (measured, or a model standing for the measurement, with its
+uncertainty) and an *engineering* model of it are excited by the same input
+``w``.  The engineering model gets an extra force input ``u`` and an extra
+displacement output ``y`` where it is believed to be wrong; a controller
+``u = K y`` is synthesised so that the engineering model's response follows the
+true one for every true system in the uncertainty set.  The controller is then
+the missing dynamics: with the force applied as :math:`-u`,
+
+.. math::
+    K(s) \approx D_u(s) = D_t(s) - D_e(s),
+
+the difference of the local dynamic stiffnesses of the two systems (thesis
+eqs. 3.7-3.9; for a mass, damper and spring, :math:`D_u = \Delta m\,s^2 +
+\Delta c\,s + \Delta k`).
+
+The generalized plant (thesis fig. 3.3) has inputs ``[w_Delta; w; u]`` and
+outputs ``[z_Delta; z; y]``:
+
+.. math::
+    A = \begin{bmatrix} A_t & 0\\ 0 & A_e\end{bmatrix},\
+    B_1 = \begin{bmatrix} B_t\\ B_{e1}\end{bmatrix} W_w,\
+    B_2 = \begin{bmatrix} 0\\ -B_{e2}\end{bmatrix},\
+    C_1 = W_z^{-1}\begin{bmatrix} C_t & -C_{e1}\end{bmatrix},\
+    C_2 = \begin{bmatrix} 0 & C_{e2}\end{bmatrix},
+
+plus the uncertainty channels ``w_Delta``/``z_Delta`` of the true system's
+LFT.  Robust performance (mu at most 1 for the real parameter blocks and a
+full complex performance block) means: for every true system in the set,
+:math:`|x_t - x_e| \le W_z` for unit excitation :math:`|w| \le W_w`.
+
+The thesis plant has no control penalty and no sensor noise, so ``D12 = 0``
+and ``D21 = 0``: a singular H-infinity problem.  Here a small control penalty
+:math:`\varepsilon_u u` and sensor noise :math:`\varepsilon_y n` are added
+(``regularization``), scaled to the plant so that they change the controller by
+far less than the identification error; :func:`identify` reports it and
+``tests/test_mbi.py`` measures the effect by halving it.
+
+References
+----------
+.. [M] R. J. Madden, *Identification of unmodeled dynamics in rotor systems using
+   mu-synthesis approach*, M.S. thesis, Cleveland State University, ch. 3.
+.. [WPM] Y. Wang, B. Pettinato and E. Maslen, "Model-based identification of
+   unmodeled dynamics", 2009 (cited in [M]_).
+"""
+from __future__ import annotations
+
+import sys
+import time
+from dataclasses import dataclass, field
+
+import control as ct
+import numpy as np
+
+from .errors import IllPosedError, ModelError
+from .lti import as_ss, check_finite, freqresp, is_stable, lft_lower, ss
+from .mu import Block, BlockStructure
+
+__all__ = ["MBIPlant", "mbi_plant", "ImpedanceFit", "fit_impedance", "WzTry", "MBIResult", "identify"]
+
+
+def _index(sys, name, kind, what):
+    labels = list(sys.input_labels if kind == "input" else sys.output_labels)
+    if name not in labels:
+        raise ModelError(f"{what}: no {kind} named {name!r}; its {kind}s are {labels}")
+    return labels.index(name)
+
+
+@dataclass
+class MBIPlant:
+    """The model-based identification plant and what it was built from.
+
+    Attributes
+    ----------
+    P : control.StateSpace
+        Inputs ``[w_Delta (nunc); w; (n_y if regularised); u]``, outputs
+        ``[z_Delta (nunc); z; (z_u if regularised); y]``.
+    structure : BlockStructure
+        The real blocks of the true system followed by the full complex
+        performance block.
+    nunc : int
+        Number of uncertainty channels.
+    Ww, Wz : float
+        Excitation size (unit of the input) and allowed error (unit of the output).
+    eps_u, eps_y : float
+        Regularisation (control penalty, sensor noise); zero when none.
+    """
+    P: ct.StateSpace
+    structure: BlockStructure
+    nunc: int
+    Ww: float
+    Wz: float
+    eps_u: float
+    eps_y: float
+    true: object
+    engineering: ct.StateSpace
+    ports: dict
+
+    nmeas = 1
+    ncon = 1
+
+
+def _true_parts(true, excitation, measurement):
+    """(P_true restricted to [w_unc; excitation] -> [z_unc; measurement], structure blocks, nunc)."""
+    from .uncertain import UncertainModel
+    if isinstance(true, UncertainModel):
+        P = true.P
+        nunc = true.nunc
+        blocks = list(true.structure.blocks)
+    else:
+        P = as_ss(true, "true system")
+        nunc = 0
+        blocks = []
+    check_finite(P, "true system")
+    i = _index(P, excitation, "input", "true system")
+    o = _index(P, measurement, "output", "true system")
+    if i < nunc or o < nunc:
+        raise ModelError("true system: the excitation/measurement ports must not be uncertainty channels")
+    cols = list(range(nunc)) + [i]
+    rows = list(range(nunc)) + [o]
+    A, B, C, D = (np.asarray(X, float) for X in (P.A, P.B, P.C, P.D))
+    return ss(A, B[:, cols], C[rows], D[np.ix_(rows, cols)]), blocks, nunc
+
+
+def mbi_plant(true, engineering, *, excitation: str, measurement: str, control_input: str,
+              control_output: str, Ww: float = 1.0, Wz: float = 1e-3,
+              regularization: float | None = 1e-4) -> MBIPlant:
+    r"""Assemble the mu-controlled model-based identification plant (thesis fig. 3.3).
+
+    Parameters
+    ----------
+    true : control.StateSpace or mutext.uncertain.UncertainModel
+        The true system.  An :class:`~mutext.uncertain.UncertainModel` brings its
+        real parameter blocks into the structure.  Must be stable.
+    engineering : control.StateSpace
+        The engineering model; must have the inputs ``excitation`` and
+        ``control_input`` and the outputs ``measurement`` and ``control_output``.
+    excitation, measurement : str
+        Names of the shared excitation input and measured output (same units in
+        both systems, e.g. N and m).
+    control_input, control_output : str
+        Where the engineering model is unsure: a force input and a displacement
+        output at the same place.  The plant applies ``-u`` there, so that
+        ``K`` approximates the missing dynamic stiffness :math:`D_u`.
+    Ww : float
+        Size of the excitation (input unit, e.g. N).
+    Wz : float
+        Allowed error of the measured output (output unit, e.g. m).
+    regularization : float or None
+        Relative size of the control penalty and sensor noise that make the
+        H-infinity problem regular (None or 0: the singular plant as in the
+        thesis).  ``eps_u`` is this times ``Ww``-scaled error per unit force,
+        ``eps_y`` this times the typical size of ``y``, both measured on the
+        engineering model's static and peak gains.
+
+    Returns
+    -------
+    MBIPlant
+
+    Raises
+    ------
+    ModelError
+        Port names that do not exist, non-finite matrices, non-positive weights.
+    IllPosedError
+        An unstable true or engineering system (the identification compares
+        responses, which must exist).
+    """
+    if not (np.isfinite(Ww) and Ww > 0 and np.isfinite(Wz) and Wz > 0):
+        raise ModelError(f"Ww and Wz must be positive and finite, got Ww={Ww}, Wz={Wz}")
+    E = as_ss(engineering, "engineering model")
+    check_finite(E, "engineering model")
+    Pt, blocks, nunc = _true_parts(true, excitation, measurement)
+    ie = _index(E, excitation, "input", "engineering model")
+    iu = _index(E, control_input, "input", "engineering model")
+    oe = _index(E, measurement, "output", "engineering model")
+    oy = _index(E, control_output, "output", "engineering model")
+    for what, sysm in (("true system", Pt), ("engineering model", E)):
+        if sysm.nstates and not is_stable(sysm):
+            poles = np.linalg.eigvals(np.asarray(sysm.A, float))
+            raise IllPosedError(f"the {what} is unstable (pole at {poles[np.argmax(poles.real)]:.4g}); "
+                                "model-based identification compares steady frequency responses")
+    At, Bt, Ct, Dt = (np.asarray(X, float) for X in (Pt.A, Pt.B, Pt.C, Pt.D))
+    Ae, Be, Ce, De = (np.asarray(X, float) for X in (E.A, E.B, E.C, E.D))
+    if abs(De[oy, iu]) > 0 or abs(De[oe, iu]) > 0 or abs(De[oy, ie]) > 0:
+        raise ModelError("engineering model: the control and measured outputs must be displacements "
+                         "(no direct feedthrough from the inputs)")
+    nt, ne = At.shape[0], Ae.shape[0]
+    eps_u = eps_y = 0.0
+    if regularization:
+        # scale the penalty to the plant: the error per unit control force and the
+        # size of y per unit excitation, both at the engineering model's static gain
+        # and at its largest resonance on a coarse grid
+        w = np.logspace(-2, 2, 200) * max(1.0, float(np.max(np.abs(np.linalg.eigvals(Ae)))) / 10)
+        H = freqresp(E, w)
+        g_zu = np.max(np.abs(H[:, oe, iu])) / Wz
+        g_yw = np.max(np.abs(H[:, oy, ie])) * Ww
+        eps_u = float(regularization) * g_zu
+        eps_y = float(regularization) * g_yw
+    reg = bool(regularization)
+    # inputs [w_unc (nunc), w, (n), u]; outputs [z_unc (nunc), z, (z_u), y]
+    nin = nunc + 1 + (1 if reg else 0) + 1
+    nout = nunc + 1 + (1 if reg else 0) + 1
+    A = np.block([[At, np.zeros((nt, ne))], [np.zeros((ne, nt)), Ae]])
+    B = np.zeros((nt + ne, nin))
+    C = np.zeros((nout, nt + ne))
+    D = np.zeros((nout, nin))
+    iw, iuu = nunc, nin - 1
+    oz, oyy = nunc, nout - 1
+    B[:nt, :nunc] = Bt[:, :nunc]
+    B[:nt, iw] = Bt[:, nunc] * Ww
+    B[nt:, iw] = Be[:, ie] * Ww
+    B[nt:, iuu] = -Be[:, iu]
+    C[:nunc, :nt] = Ct[:nunc]
+    D[:nunc, :nunc] = Dt[:nunc, :nunc]
+    D[:nunc, iw] = Dt[:nunc, nunc] * Ww
+    C[oz, :nt] = Ct[nunc] / Wz
+    C[oz, nt:] = -Ce[oe] / Wz
+    D[oz, :nunc] = Dt[nunc, :nunc] / Wz
+    D[oz, iw] = (Dt[nunc, nunc] - De[oe, ie]) * Ww / Wz
+    C[oyy, nt:] = Ce[oy]
+    D[oyy, iw] = De[oy, ie] * Ww
+    inputs = [f"w_unc{i + 1}" for i in range(nunc)] + ["w"]
+    outputs = [f"z_unc{i + 1}" for i in range(nunc)] + ["z"]
+    if true is not None and nunc:
+        inputs[:nunc] = list(true.P.input_labels[:nunc])
+        outputs[:nunc] = list(true.P.output_labels[:nunc])
+    if reg:
+        D[oyy, nunc + 1] = eps_y
+        D[nunc + 1, iuu] = eps_u
+        inputs.append("n")
+        outputs.append("z_u")
+    inputs.append("u")
+    outputs.append("y")
+    P = ss(A, B, C, D, inputs=inputs, outputs=outputs)
+    nperf = 2 if reg else 1
+    structure = BlockStructure(blocks + [Block.full(nperf, nperf, "performance")])
+    return MBIPlant(P, structure, nunc, float(Ww), float(Wz), eps_u, eps_y, true, E,
+                    {"excitation": excitation, "measurement": measurement,
+                     "control_input": control_input, "control_output": control_output})
+
+
+def controlled_engineering(plant: MBIPlant, K) -> ct.StateSpace:
+    """The engineering model with the identified dynamics attached: input
+    ``excitation``, output ``measurement`` (the 'controlled engsys' of the thesis)."""
+    E = plant.engineering
+    pr = plant.ports
+    ie, iu = (list(E.input_labels).index(pr[k]) for k in ("excitation", "control_input"))
+    oe, oy = (list(E.output_labels).index(pr[k]) for k in ("measurement", "control_output"))
+    A, B, C, D = (np.asarray(X, float) for X in (E.A, E.B, E.C, E.D))
+    G = ss(A, np.column_stack([B[:, ie], -B[:, iu]]), C[[oe, oy]], D[np.ix_([oe, oy], [ie, iu])],
+           inputs=[pr["excitation"], "u"], outputs=[pr["measurement"], "y"])
+    return lft_lower(G, K, 1, 1)
+
+
+def _channels(plant: MBIPlant, omega):
+    """Frequency responses of the nominal performance channels: z<-w, z<-u, y<-w, y<-u."""
+    H = freqresp(plant.P, omega)   # (nout, nin, nw)
+    n = plant.nunc
+    return H[n, n], H[n, -1], H[-1, n], H[-1, -1]
+
+
+@dataclass
+class ImpedanceFit:
+    r"""Least-squares reading of a controller as a mass, damper and spring.
+
+    :math:`K(j\omega) \approx dk + j\omega\,dc - \omega^2 dm` on ``band``
+    (rad/s), each frequency weighted by how much the measured output depends on
+    ``K`` there (see :func:`fit_impedance`).
+
+    Attributes
+    ----------
+    dm, dc, dk : float
+        Added mass (kg), damping (N s/m) and stiffness (N/m).
+    residual : float
+        Weighted relative residual :math:`\|w(K - \hat K)\| / \|w K\|` (0 = perfect).
+    band : tuple of float
+        Lowest and highest frequency (rad/s) of the identifiable band.
+    fits : bool
+        ``residual <= tol``: the mass-damper-spring form describes ``K``.
+    description : str
+    sigma : tuple of float
+        Standard uncertainty of ``(dm, dc, dk)``: with the identification
+        weights :math:`|s(\omega)|`, the spread that changes the normalised error
+        by about one, i.e. what the measurement cannot tell apart.
+    """
+    dm: float
+    dc: float
+    dk: float
+    residual: float
+    band: tuple
+    fits: bool
+    description: str
+    omega: np.ndarray = field(repr=False, default=None)
+    weight: np.ndarray = field(repr=False, default=None)
+    sigma: tuple = (np.nan, np.nan, np.nan)
+
+    def response(self, omega) -> np.ndarray:
+        """:math:`dk + j\\omega dc - \\omega^2 dm`."""
+        w = np.asarray(omega, float)
+        return self.dk + 1j * w * self.dc - w ** 2 * self.dm
+
+
+def identifiable_band(plant: MBIPlant, K, omega):
+    r"""Sensitivity of the normalised error to the controller, and the band where it matters.
+
+    A change :math:`\delta K` changes the normalised error by
+    :math:`\delta z = s(\omega)\,\delta K` with
+    :math:`s = P_{zu}P_{yw}/(1 - P_{yu}K)^2` (nominal channels).  ``K`` is
+    pinned down where a 100 % error in it would exceed the allowed error:
+    :math:`|s(\omega)\,K(j\omega)| \ge 1`.
+
+    Returns
+    -------
+    sensitivity : ndarray
+        :math:`|s(\omega)|` on ``omega``.
+    mask : ndarray of bool
+        Frequencies inside the identifiable band.
+    """
+    omega = np.asarray(omega, float)
+    _, Pzu, Pyw, Pyu = _channels(plant, omega)
+    Kj = freqresp(as_ss(K), omega)[0, 0]
+    s = np.abs(Pzu * Pyw / (1 - Pyu * Kj) ** 2)
+    return s, s * np.abs(Kj) >= 1.0
+
+
+def fit_impedance(K, omega, weight=None, tol: float = 0.1) -> ImpedanceFit:
+    r"""Fit :math:`K(j\omega) \approx dk + j\omega dc - \omega^2 dm` by weighted least squares.
+
+    Parameters
+    ----------
+    K : control.StateSpace or array_like of complex
+        The controller, or its frequency response on ``omega``.
+    omega : array_like
+        Frequencies (rad/s) of the band to fit.
+    weight : array_like, optional
+        Non-negative weight per frequency (default 1).
+    tol : float
+        Largest weighted relative residual for which the form is accepted.
+
+    Returns
+    -------
+    ImpedanceFit
+    """
+    omega = np.asarray(omega, float).ravel()
+    if omega.size < 3:
+        raise ModelError(f"fit_impedance needs at least 3 frequencies in the band, got {omega.size}")
+    Kj = freqresp(as_ss(K), omega)[0, 0] if isinstance(K, (ct.StateSpace, ct.TransferFunction)) \
+        else np.asarray(K, complex).ravel()
+    if Kj.shape != omega.shape:
+        raise ModelError(f"K has {Kj.size} response values for {omega.size} frequencies")
+    wgt = np.ones_like(omega) if weight is None else np.asarray(weight, float).ravel()
+    # real part: dk - w^2 dm; imaginary part: w dc; scale the columns for conditioning
+    A = np.zeros((2 * omega.size, 3))
+    A[:omega.size, 0] = -omega ** 2
+    A[:omega.size, 2] = 1.0
+    A[omega.size:, 1] = omega
+    b = np.concatenate([Kj.real, Kj.imag])
+    W = np.concatenate([wgt, wgt])
+    col = np.linalg.norm(A * W[:, None], axis=0)
+    col[col == 0] = 1.0
+    Aw = A * W[:, None] / col
+    x, *_ = np.linalg.lstsq(Aw, b * W, rcond=None)
+    dm, dc, dk = x / col
+    fit = dk + 1j * omega * dc - omega ** 2 * dm
+    res = float(np.linalg.norm(wgt * (Kj - fit)) / max(np.linalg.norm(wgt * Kj), 1e-300))
+    # standard uncertainty: the weights are read as inverse standard deviations of K
+    # (for the identification weights 1/|s|: the change of K that moves the
+    # normalised error by one); without weights, from the residual variance
+    cov = np.linalg.pinv(Aw.T @ Aw) / np.outer(col, col)
+    if weight is None:
+        dof = max(2 * omega.size - 3, 1)
+        cov *= float(np.sum(np.abs(Kj - fit) ** 2)) / dof
+    sigma = np.sqrt(np.maximum(np.diag(cov), 0.0))
+    ok = res <= tol
+    terms = []
+    for val, sd, unit, what in zip((dm, dc, dk), sigma, ("kg", "N s/m", "N/m"), ("mass", "damper", "spring")):
+        terms.append(f"{what} {val:+.4g} +/- {sd:.2g} {unit}")
+    if ok:
+        desc = f"added {', '.join(terms)} (residual {res:.2%})"
+    else:
+        desc = (f"not a mass-damper-spring: best such fit ({', '.join(terms)}) leaves {res:.0%} of K "
+                "unexplained; look at K's shape (resonances, phase) instead")
+    return ImpedanceFit(float(dm), float(dc), float(dk), res, (float(omega.min()), float(omega.max())),
+                        bool(ok), desc, omega, wgt, tuple(float(v) for v in sigma))
+
+
+@dataclass
+class WzTry:
+    """One D-K run of the W_z search."""
+    Wz: float
+    mu_upper: float
+    mu_lower: float
+    controller_order: int
+    seconds: float
+    iterations: int
+
+
+@dataclass
+class MBIResult:
+    r"""Result of :func:`identify`.
+
+    Attributes
+    ----------
+    K : control.StateSpace
+        The identified dynamics (force per displacement, applied as :math:`-u`):
+        :math:`K \approx D_u`.
+    Wz : float
+        The accepted error bound (output unit).
+    mu_upper, mu_lower : float
+        Certified robust-performance bounds of the final controller at ``Wz``.
+    tries : list of WzTry
+        Every W_z tried, in order.
+    plant : MBIPlant
+        The plant at the accepted ``Wz``.
+    fit : ImpedanceFit
+        Mass-damper-spring reading of ``K`` on its identifiable band.
+    controlled : control.StateSpace
+        The engineering model with ``K`` attached.
+    dk : mutext.dk.DKResult
+        The final D-K run.
+    seconds : float
+    notes : list of str
+    """
+    K: ct.StateSpace
+    Wz: float
+    mu_upper: float
+    mu_lower: float
+    tries: list
+    plant: MBIPlant
+    fit: ImpedanceFit
+    controlled: ct.StateSpace
+    dk: object
+    seconds: float
+    omega: np.ndarray = field(repr=False, default=None)
+    notes: list = field(default_factory=list)
+
+    def error(self, true_system, omega=None) -> np.ndarray:
+        """|x_true - x_controlled| (output unit per input unit) of a true system over ``omega``."""
+        omega = self.omega if omega is None else np.asarray(omega, float)
+        pr = self.plant.ports
+        T = as_ss(true_system)
+        i = list(T.input_labels).index(pr["excitation"])
+        o = list(T.output_labels).index(pr["measurement"])
+        return np.abs(freqresp(T, omega)[o, i] - freqresp(self.controlled, omega)[0, 0])
+
+
+def _default_omega(plant: MBIPlant, n: int = 300):
+    poles = np.linalg.eigvals(np.asarray(plant.P.A, float))
+    mags = np.abs(poles[np.abs(poles) > 0])
+    lo, hi = (mags.min() / 10, mags.max() * 10) if mags.size else (1e-2, 1e2)
+    return np.logspace(np.log10(lo), np.log10(hi), n)
+
+
+def identify(true, engineering, *, excitation: str, measurement: str, control_input: str,
+             control_output: str, Ww: float = 1.0, Wz: float | None = None, tol: float = 0.05,
+             max_tries: int = 8, regularization: float | None = 1e-4, omega=None,
+             dk_options: dict | None = None, out=sys.stdout) -> MBIResult:
+    r"""Identify the unmodeled dynamics of ``engineering`` by mu-synthesis (thesis sec. 3.5).
+
+    Runs D-K iteration on the plant of :func:`mbi_plant` and tunes :math:`W_z`
+    by the thesis's step-7 rule, automated: :math:`\mu > 1` means the bound is
+    too tight (raise :math:`W_z`), :math:`\mu < 1 - \text{tol}` too loose (lower
+    it).  Each new value comes from the log-log secant through the last two tries
+    (:math:`\mu` scales roughly like :math:`W_z^{-1}`), kept inside the bracket
+    once one is known.  Accepted: :math:`1 - \text{tol} \le \mu \le 1`.
+
+    Parameters
+    ----------
+    true, engineering, excitation, measurement, control_input, control_output, Ww, regularization
+        As in :func:`mbi_plant`.
+    Wz : float, optional
+        First value to try (default: 1 % of the peak open-loop error
+        :math:`W_w|x_t - x_e|`).
+    tol : float
+        Accepted distance of mu below 1.
+    max_tries : int
+        Largest number of D-K runs.
+    omega : array_like, optional
+        Frequency grid (rad/s) for the D steps, the identifiable band and the fit.
+    dk_options : dict, optional
+        Passed to :func:`mutext.dk.dk_iteration`.
+    out : file or None
+        Progress (one line per try, and the D-K tables); None for silence.
+
+    Returns
+    -------
+    MBIResult
+        If no try reached the accepted window, the best try with mu <= 1 (or the
+        lowest mu) is returned with a note saying so.
+    """
+    from .dk import dk_iteration
+    t0 = time.perf_counter()
+    kw = dict(excitation=excitation, measurement=measurement, control_input=control_input,
+              control_output=control_output, Ww=Ww, regularization=regularization)
+    probe = mbi_plant(true, engineering, Wz=1.0, **kw)
+    omega = _default_omega(probe) if omega is None else np.asarray(omega, float)
+    if omega.size == 0:
+        raise ModelError("identify: the frequency grid is empty")
+    diff = float(np.max(np.abs(freqresp(probe.P, omega)[probe.nunc, probe.nunc])))
+    E = probe.engineering
+    ref = float(np.max(np.abs(freqresp(E, omega)[list(E.output_labels).index(measurement),
+                                                 list(E.input_labels).index(excitation)]))) * Ww
+    if diff <= 1e-9 * ref:
+        raise IllPosedError("the true and engineering responses are identical on the grid "
+                            f"(largest difference {diff:.3g} against {ref:.3g}): there is nothing to identify")
+    if Wz is None:
+        Wz = 0.01 * diff
+    opts = {"max_iter": 4, "out": None if out is None else out}
+    opts.update(dk_options or {})
+    tries, runs = [], []
+    lo = hi = None      # Wz with mu > 1 (too tight) / mu <= 1
+    target = 1.0 - tol / 2
+    for k in range(max_tries):
+        plant = mbi_plant(true, engineering, Wz=Wz, **kw)
+        if out is not None:
+            print(f"[mbi] try {k + 1}: Wz = {Wz:.4g}", file=out, flush=True)
+        ti = time.perf_counter()
+        res = dk_iteration(plant.P, plant.structure, 1, 1, omega=omega, **opts)
+        mu = float(max(res.mu_upper_dg, 0.0)) if np.isfinite(res.mu_upper_dg) else float(res.mu_upper)
+        tries.append(WzTry(Wz, mu, float(res.mu_lower), res.controller_order, time.perf_counter() - ti,
+                           len(res.history)))
+        runs.append((plant, res))
+        if out is not None:
+            print(f"[mbi]        mu <= {mu:.4f} (lower {res.mu_lower:.4f})", file=out, flush=True)
+        if 1.0 - tol <= mu <= 1.0:
+            break
+        if mu > 1.0:
+            lo = Wz if lo is None else max(lo, Wz)
+        else:
+            hi = Wz if hi is None else min(hi, Wz)
+        # log-log secant on the last two tries, slope -1 on the first
+        if len(tries) >= 2 and tries[-1].Wz != tries[-2].Wz and tries[-1].mu_upper > 0 and tries[-2].mu_upper > 0:
+            a, b = tries[-2], tries[-1]
+            slope = (np.log(b.mu_upper) - np.log(a.mu_upper)) / (np.log(b.Wz) - np.log(a.Wz))
+            slope = slope if slope < -0.05 else -1.0
+        else:
+            slope = -1.0
+        new = Wz * np.exp((np.log(target) - np.log(max(mu, 1e-12))) / slope)
+        if lo is not None and hi is not None:
+            if not lo < new < hi:
+                new = np.sqrt(lo * hi)
+        Wz = float(new)
+    ok = [i for i, t in enumerate(tries) if t.mu_upper <= 1.0]
+    best = min(ok, key=lambda i: tries[i].Wz) if ok else int(np.argmin([t.mu_upper for t in tries]))
+    plant, res = runs[best]
+    notes = []
+    if not 1.0 - tol <= tries[best].mu_upper <= 1.0:
+        notes.append(f"W_z search stopped after {len(tries)} tries without mu in [{1 - tol:.3g}, 1]; "
+                     f"returning the try with {'the smallest W_z at mu <= 1' if ok else 'the lowest mu (> 1)'}")
+    if plant.eps_u or plant.eps_y:
+        notes.append(f"regularised: control penalty {plant.eps_u:.3g} per unit u, sensor noise "
+                     f"{plant.eps_y:.3g} (the thesis plant is singular)")
+    sens, band = identifiable_band(plant, res.K, omega)
+    if band.sum() < 3:
+        notes.append("K has almost no identifiable band (|s K| >= 1 at fewer than 3 frequencies); "
+                     "the fit uses the whole grid")
+        band = np.ones_like(band)
+    fit = fit_impedance(res.K, omega[band], weight=sens[band])
+    return MBIResult(res.K, tries[best].Wz, tries[best].mu_upper, tries[best].mu_lower, tries, plant, fit,
+                     controlled_engineering(plant, res.K), res, time.perf_counter() - t0, omega, notes)
+
+
+def impedance_response(coeffs: dict, omega) -> np.ndarray:
+    """:math:`dk + j\\omega dc - \\omega^2 dm` for ``coeffs = {"dm", "dc", "dk"}`` (missing keys are 0)."""
+    w = np.asarray(omega, float)
+    return coeffs.get("dk", 0.0) + 1j * w * coeffs.get("dc", 0.0) - w ** 2 * coeffs.get("dm", 0.0)
+
+
+def relative_error(K, reference, omega) -> float:
+    r"""RMS over ``omega`` of :math:`|K(j\omega) - D(j\omega)| / |D(j\omega)|`, with
+    ``reference`` a dict ``{"dm", "dc", "dk"}`` or a response array on ``omega``."""
+    omega = np.asarray(omega, float)
+    D = impedance_response(reference, omega) if isinstance(reference, dict) else np.asarray(reference, complex)
+    Kj = freqresp(as_ss(K), omega)[0, 0]
+    return float(np.sqrt(np.mean(np.abs(Kj - D) ** 2 / np.abs(D) ** 2)))

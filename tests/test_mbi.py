@@ -1,0 +1,164 @@
+"""Model-based identification (thesis ch. 3): plant assembly, the reading of K, and the trials.
+
+The analytic checks close the plant with the known difference D_u (exact for a
+spring): the engineering model must then reproduce the true one exactly.  The
+trial tests hide a mass, damper and/or spring difference on cart 3 and require
+that the identification finds it.
+"""
+import io
+
+import control as ct
+import numpy as np
+import pytest
+
+from mutext.errors import IllPosedError, ModelError
+from mutext.examples import three_mass as tm
+from mutext.lti import freqresp, lft_lower, mck_to_ss
+from mutext.mbi import (controlled_engineering, fit_impedance, identify, impedance_response, mbi_plant,
+                        relative_error)
+
+W = np.logspace(0, 2, 60)
+
+
+def _plant(trial, regularization=None, Wz=4e-4, uncertain=False):
+    args = tm.mbi_arguments(tm.TRIALS[trial])
+    if not uncertain:
+        args["true"] = tm.mechanical_model(tm.TRIALS[trial].true)
+    return mbi_plant(**args, Wz=Wz, regularization=regularization)
+
+
+@pytest.mark.parametrize("trial, k", [("1a", 186.0), ("1b", -186.0)])
+def test_exact_difference_closes_the_error(trial, k):
+    """K = D_u (a spring) makes the nominal error vanish; the sign convention is K = +D_u."""
+    pl = _plant(trial)
+    K = ct.ss([], [], [], [[k]])
+    CL = lft_lower(pl.P, K, 1, 1)
+    open_loop = np.abs(freqresp(pl.P, W)[0, 0]).max()
+    assert open_loop > 10          # the models do differ (normalised error >> 1)
+    assert np.abs(freqresp(CL, W)[0, 0]).max() < 1e-9 * open_loop
+    # the wrong sign does not
+    CLw = lft_lower(pl.P, ct.ss([], [], [], [[-k]]), 1, 1)
+    assert np.abs(freqresp(CLw, W)[0, 0]).max() > 1.0
+
+
+def test_controlled_engineering_matches_true():
+    tr = tm.TRIALS["1a"]
+    pl = _plant("1a")
+    G = controlled_engineering(pl, ct.ss([], [], [], [[tr.Du["dk"]]]))
+    T = tm.mechanical_model(tr.true)
+    np.testing.assert_allclose(freqresp(G, W)[0, 0], freqresp(T, W)[0, 0], rtol=1e-9)
+
+
+def test_plant_structure_and_uncertainty_channels():
+    pl = _plant("4", regularization=1e-4, uncertain=True)
+    names = [b.name for b in pl.structure.blocks]
+    assert names == ["m3", "c3", "k3", "performance"]
+    assert pl.structure.blocks[-1].rows == 2            # error and control penalty
+    assert pl.P.ninputs == pl.structure.nrows + 1 and pl.P.noutputs == pl.structure.ncols + 1
+    assert pl.eps_u > 0 and pl.eps_y > 0
+    # closing the true system's uncertainty at a corner equals the rig rebuilt there
+    U = tm.true_model(tm.TRIALS["4"])
+    d = np.array([1.0, -1.0, 0.5])
+    closed = U.close(d)
+    rebuilt = U.at(U.values(d))
+    np.testing.assert_allclose(freqresp(closed, W), freqresp(rebuilt, W), rtol=1e-8, atol=1e-14)
+
+
+def test_fit_impedance_recovers_mass_damper_spring():
+    rng = np.random.default_rng(3)
+    for _ in range(5):
+        dm, dc, dk = rng.normal(size=3) * [1.0, 5.0, 200.0]
+        Kj = impedance_response({"dm": dm, "dc": dc, "dk": dk}, W)
+        f = fit_impedance(Kj, W, weight=rng.uniform(0.1, 10, W.size))
+        assert f.fits and f.residual < 1e-10
+        np.testing.assert_allclose([f.dm, f.dc, f.dk], [dm, dc, dk], rtol=1e-8)
+
+
+def test_fit_impedance_says_when_the_form_does_not_fit():
+    K = ct.tf([1e4], [1, 0.5, 400])       # a resonance: no mass-damper-spring reading
+    f = fit_impedance(K, W)
+    assert not f.fits and f.residual > 0.1
+    assert "not a mass-damper-spring" in f.description
+
+
+def test_relative_error():
+    K = ct.ss([], [], [], [[186.0 * 1.02]])
+    assert relative_error(K, {"dk": 186.0}, W) == pytest.approx(0.02, rel=1e-9)
+
+
+def test_bad_inputs_get_clear_errors():
+    tr = tm.TRIALS["1a"]
+    E = tm.mechanical_model(tr.engineering)
+    T = tm.mechanical_model(tr.true)
+    ports = dict(excitation="f1", measurement="x1", control_input="f3", control_output="x3")
+    with pytest.raises(ModelError, match="no input named 'f9'"):
+        mbi_plant(T, E, **{**ports, "excitation": "f9"})
+    with pytest.raises(ModelError, match="no output named 'x2'"):
+        mbi_plant(T, E, **{**ports, "control_output": "x2"})
+    with pytest.raises(ModelError, match="Wz must be positive"):
+        mbi_plant(T, E, **ports, Wz=0.0)
+    M, C, Kmat = tm.matrices(tr.true)
+    Kmat[2, 2] -= 1500.0                     # a negative spring to ground on cart 3
+    unstable = mck_to_ss(M, C, Kmat, inputs={"f1": 0, "f3": 2}, outputs={"x1": 0, "x3": 2})
+    with pytest.raises(IllPosedError, match="true system is unstable"):
+        mbi_plant(unstable, E, **ports)
+    with pytest.raises(ModelError, match="grid is empty"):
+        identify(T, E, **ports, omega=[], out=None)
+    with pytest.raises(IllPosedError, match="nothing to identify"):
+        identify(E, E, **ports, out=None)
+
+
+def _check_trial(name, res, rtol):
+    tr = tm.TRIALS[name]
+    assert 0.9 <= res.mu_upper <= 1.0 + 1e-9
+    assert res.mu_lower <= res.mu_upper + 1e-9
+    assert tr.Wz / 5 < res.Wz < tr.Wz * 5                 # same order as the thesis
+    assert res.fit.fits
+    fit = {"dm": res.fit.dm, "dc": res.fit.dc, "dk": res.fit.dk}
+    for key, expected in tr.Du.items():
+        if expected:
+            assert fit[key] == pytest.approx(expected, rel=rtol), (key, fit, tr.Du)
+    # the fitted impedance (zero coefficients included) against D_u on the band
+    band = res.fit.omega
+    D = impedance_response(tr.Du, band)
+    assert np.sqrt(np.mean(np.abs(res.fit.response(band) - D) ** 2 / np.abs(D) ** 2)) < rtol
+    # the controlled model follows every true rig in the set within W_z (per unit force)
+    U = tm.true_model(tr)
+    for d in U.sample(4, rng=1, vertices=True):
+        err = res.error(U.at(U.values(d)))
+        assert err.max() <= 1.05 * res.Wz
+
+
+def test_identify_spring_trial_1a():
+    buf = io.StringIO()
+    res = identify(**tm.mbi_arguments(tm.TRIALS["1a"]), Wz=tm.TRIALS["1a"].Wz, out=buf)
+    _check_trial("1a", res, 0.05)
+    assert "[mbi] try 1: Wz = 0.0004" in buf.getvalue()
+    assert len(res.tries) >= 1 and all(t.mu_upper > 0 for t in res.tries)
+
+
+TRIAL5_GAP = ("with 10 % uncertainty the D-K iteration, which treats the real parameters as complex "
+              "scalars, accepts W_z = 5.8 mm (thesis 2.6 mm); the identifiable band then shrinks to "
+              "4.6-7.3 rad/s, where only dk - w^2 dm is pinned down, and the fit misses D_u")
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("name", ["1b", "2", "3", "4",
+                                  pytest.param("5", marks=pytest.mark.xfail(strict=True, reason=TRIAL5_GAP))])
+def test_identify_trial(name):
+    tr = tm.TRIALS[name]
+    res = identify(**tm.mbi_arguments(tr), Wz=tr.Wz, out=None)
+    _check_trial(name, res, 0.15 if name == "5" else 0.05)
+
+
+@pytest.mark.slow
+def test_regularization_does_not_change_the_identified_dynamics():
+    """Halving the control penalty and sensor noise changes K by far less than its error to D_u."""
+    tr = tm.TRIALS["1a"]
+    args = tm.mbi_arguments(tr)
+    a = identify(**args, Wz=tr.Wz, regularization=1e-4, out=None, max_tries=1)
+    b = identify(**args, Wz=tr.Wz, regularization=5e-5, out=None, max_tries=1)
+    band = a.fit.omega
+    Ka, Kb = freqresp(a.K, band)[0, 0], freqresp(b.K, band)[0, 0]
+    assert np.max(np.abs(Ka - Kb) / np.abs(Ka)) < 0.01
+    assert abs(a.mu_upper - b.mu_upper) < 0.01
