@@ -13,10 +13,17 @@ iteration alternates two steps on the upper bound
 
 * **K step**: with rational, stable, minimum-phase scalings :math:`\hat D(s)`
   fixed, an H-infinity controller for :math:`\hat D P \hat D^{-1}` by
-  :func:`mutext.hinf.hinfsyn`;
-* **D step**: the optimal scalings :math:`D(\omega)` of the new closed loop on
-  a frequency grid (:func:`mutext.mu.mu_sweep`), each fitted by a stable,
+  :func:`mutext.hinf.hinfsyn` (0.1 % above the optimal level; slycot's
+  Riccati synthesis, verified, if the LMI controller fails; then once more
+  with lower-order scalings);
+* **D step**: the optimal diagonal scalings :math:`D(\omega)` of the new
+  closed loop on a frequency grid, each block's fitted by a stable,
   minimum-phase, biproper transfer function of order 0-5.
+
+The pointwise scalings minimise the convex :math:`\log\bar\sigma(e^XMe^{-X})`
+(one log scaling per block, the last fixed to 0) by the same
+Osborne-plus-ellipsoid method as ``mutext.mu.mu_upper(method="osborne")``,
+run on all frequencies at once and warm-started from the previous iteration.
 
 What the fit must achieve is not closeness to the pointwise optimum but a
 scaled closed loop whose peak stays near the peak of :math:`\mu`: far from the
@@ -25,22 +32,27 @@ and frequency the D step therefore computes the interval of
 :math:`\log d_k` over which :math:`\bar\sigma(DMD^{-1})` stays below
 :math:`(1 + \text{fit\_tol})\,\max_\omega\mu` (a convex function of
 :math:`\log d_k`, so the interval is found by bisection), and fits the middle of
-that interval, weighted by the inverse of its half width.  The lowest order
-whose fit stays inside the interval is used; frequencies where the fitted
-scalings together still exceed the level get narrower intervals and the fit is
-repeated.
+that interval, weighted by the inverse of its half width.  Orders are raised
+one at a time for the worst-fitted block until every fit stays inside half its
+interval or a budget of added states is spent (the LMI K step slows down
+steeply with the plant order); frequencies where the fitted scalings together
+still exceed the level get narrower intervals and the fit is repeated.
 
 The fit (:func:`fit_dscale`) works on :math:`\Phi(x) = |D(j\omega)|^2`,
-:math:`x = \omega^2`, a positive rational function of :math:`x`.  Its poles are
-located by vector fitting (a sequence of linear least-squares problems,
-Gustavsen and Semlyen [GS]_) and its residues by a convex quadratic program
-with :math:`\Phi \ge 0` imposed on a dense grid; a spectral factorisation then
-gives :math:`\hat D(s)` with all poles and zeros in the left half plane.
+:math:`x = \omega^2`, a positive rational function of :math:`x`.  Its poles
+(real, or complex pairs for resonant scalings) are located by vector fitting (a
+sequence of linear least-squares problems, Gustavsen and Semlyen [GS]_) and its
+residues by a convex quadratic program with :math:`\Phi \ge 0` imposed on a
+dense grid; a spectral factorisation then gives :math:`\hat D(s)` with all
+poles and zeros in the left half plane.
 
 Real parameters are treated as complex scalars in the iteration (D scalings
-only, as in the classical ``dksyn``); the final closed loop is analysed with
-the optimal unfitted scalings on a fine grid, and, when the structure has real
-blocks, also with D-G scalings.
+only, as in the classical ``dksyn``).  The best closed loop is then analysed
+with the optimal, unfitted scalings on a fine grid whose peaks are refined
+(every value is :math:`\bar\sigma(DMD^{-1})` for an explicit :math:`D`, a
+certified bound at that frequency), with lower bounds at the peaks
+(:func:`mutext.mu.mu_sweep`) and, when the structure has real blocks, the
+D-G bound (:func:`mutext.mu.mu_upper`).
 
 References
 ----------
@@ -96,6 +108,8 @@ class DScaleFit:
     sys : control.StateSpace
         Realisation of :math:`\\hat D(s)`.
     order : int
+        Number of poles (can be below the order asked of :func:`fit_dscale`
+        when roots at the edges of the data cancel).
     error : float
         Largest weighted error of :math:`\\log|\\hat D(j\\omega)|` against the data.
     zeros, poles : ndarray
@@ -247,6 +261,10 @@ def fit_dscale(omega, mag, order: int, weight=None, iterations: int = 8) -> DSca
     Returns
     -------
     DScaleFit
+        Its poles and zeros lie within the band of ``omega`` in magnitude: a
+        root beyond the band acts there as a constant (or as ``s``) and is moved
+        to the band's edge with the gain compensated; a zero and a pole that
+        meet at an edge cancel, so the fit's order can be below ``order``.
 
     Raises
     ------
@@ -259,12 +277,14 @@ def fit_dscale(omega, mag, order: int, weight=None, iterations: int = 8) -> DSca
     Notes
     -----
     With :math:`x = (\omega/\omega_0)^2` the target :math:`\Phi_k = \text{mag}_k^2`
-    is approximated by :math:`\Phi(x) = c_0 + \sum_i c_i/(x + p_i)`; the poles
-    :math:`p_i > 0` come from vector fitting with relative weighting, the
-    residues from a convex least-squares problem with :math:`\Phi \ge 0` on a dense
-    grid.  The zeros :math:`\xi_j` of :math:`\Phi` give the zeros of
-    :math:`\hat D` as the left-half-plane roots of :math:`s^2 = -\xi_j\omega_0^2`,
-    the poles are :math:`-\omega_0\sqrt{p_i}`, and :math:`\hat D(\infty) = \sqrt{c_0}`.
+    is approximated by :math:`\Phi(x) = c_0 + \sum_i c_i/(x - a_i)`; the poles
+    :math:`a_i` (negative real, or complex pairs with damping ratio of the
+    resulting :math:`\hat D` poles at least 0.1) come from vector fitting with
+    relative weighting, the residues from a convex least-squares problem with
+    :math:`\Phi \ge 0` on a dense grid.  As :math:`x = -s^2`, every pole and
+    zero :math:`\xi` of :math:`\Phi` gives the root of :math:`\hat D` that is the
+    left-half-plane solution of :math:`s^2 = -\xi\,\omega_0^2`, and
+    :math:`\hat D(\infty) = \sqrt{c_0}`.
 
     Examples
     --------
@@ -694,7 +714,8 @@ class DKResult:
         upper bound on the D-step grid), ``orders`` (D-fit orders used in
         that K step), ``fit_peak`` (peak of the fitted-scaled closed loop of
         the previous controller, the level the K step starts from),
-        ``controller_order``, ``seconds``.
+        ``controller_order``, ``method`` (``"lmi"`` or ``"riccati"``: the
+        K-step synthesis that succeeded), ``seconds``.
     sweep : MuSweep
         Final fine-grid analysis (complex upper bound; lower bound fields
         for the given structure).
@@ -745,10 +766,27 @@ def _k_step(PD, nmeas, ncon):
         res = hinfsyn(PD, nmeas, ncon, backoff=1e-3, max_backoff=1e-3)
         return _KStep(res.K, float(res.gamma), "lmi")
     except (InfeasibleError, SolverError) as exc:
-        ref = slycot_hinfsyn(PD, nmeas, ncon, timeout=60.0)
-        if ref.status == "verified":
-            return _KStep(ref.K, float(ref.achieved), "riccati")
-        raise exc
+        first = exc
+    try:
+        # the full back-off schedule: singular plants (model-based identification)
+        # often need a few percent
+        res = hinfsyn(PD, nmeas, ncon, backoff=3e-3)
+        return _KStep(res.K, float(res.gamma), "lmi")
+    except (InfeasibleError, SolverError):
+        pass
+    ref = slycot_hinfsyn(PD, nmeas, ncon, timeout=60.0)
+    if ref.status == "verified":
+        return _KStep(ref.K, float(ref.achieved), "riccati")
+    raise first
+
+
+def _k_step_riccati(PD, nmeas, ncon):
+    """slycot's Riccati synthesis, accepted after :func:`mutext.hinf.slycot_hinfsyn`
+    verified it (closed loop rebuilt: stable, norm as claimed); :func:`_k_step` otherwise."""
+    ref = slycot_hinfsyn(PD, nmeas, ncon, timeout=60.0)
+    if ref.status == "verified":
+        return _KStep(ref.K, float(ref.achieved), "riccati")
+    return _k_step(PD, nmeas, ncon)
 
 
 def _print(out, text):
@@ -874,10 +912,14 @@ def dk_iteration(P, structure: BlockStructure, nmeas: int, ncon: int, *, omega=N
         Points of the final analysis grid (before peak refinement).
     dg : bool
         Also compute the D-G (mixed real) bound of the final closed loop.
-    synthesis : callable, optional
-        ``synthesis(PD, nmeas, ncon)`` returning an object with ``K`` and
-        ``gamma`` (default :func:`mutext.hinf.hinfsyn`, controller built 0.1 %
-        above the optimal level).
+    synthesis : {"lmi", "riccati"} or callable, optional
+        The K step.  ``"lmi"`` (default): :func:`mutext.hinf.hinfsyn`, the
+        controller built 0.1 % above the optimal level, with slycot's Riccati
+        synthesis as a verified fallback.  ``"riccati"``: slycot first (much
+        faster on K-step plants of 15 states and more), accepted only when
+        :func:`mutext.hinf.slycot_hinfsyn` verifies it, hinfsyn otherwise.  A
+        callable ``synthesis(PD, nmeas, ncon)`` must return an object with
+        ``K`` and ``gamma``.
     out : file or None
         Where the per-iteration table is printed (None: silent).
 
@@ -916,7 +958,14 @@ def dk_iteration(P, structure: BlockStructure, nmeas: int, ncon: int, *, omega=N
             raise ModelError("the frequency grid omega is empty")
         if not (np.all(np.isfinite(omega)) and np.all(omega > 0)):
             raise ModelError("the frequency grid omega must hold positive, finite frequencies (rad/s)")
-    synth = _k_step if synthesis is None else synthesis
+    if synthesis is None or synthesis == "lmi":
+        synth = _k_step
+    elif synthesis == "riccati":
+        synth = _k_step_riccati
+    elif callable(synthesis):
+        synth = synthesis
+    else:
+        raise ModelError(f"synthesis must be 'lmi', 'riccati' or a callable, got {synthesis!r}")
     with _single_thread_blas():
         return _dk(P, S, nmeas, ncon, omega, max_iter, max_order, max_states - P.nstates, fit_tol,
                    rel_improvement, patience, grid_points, final_points, dg, synth, out, t0)

@@ -40,7 +40,7 @@ __all__ = ["VariantSpec", "variant_plant", "VARIANTS", "investigate", "fit_param
 
 @dataclass(frozen=True)
 class VariantSpec:
-    """One reading of the two-mass problem.
+    r"""One reading of the two-mass problem.
 
     Attributes
     ----------

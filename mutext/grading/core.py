@@ -117,6 +117,12 @@ class Report:
 EXERCISES = {
     "ex01_two_mass_hinf": ("mutext.grading.ex01_two_mass_hinf",
                            "two-mass system: mechanical model, generalized plant, H-infinity norm, controller"),
+    "ex02_mu": ("mutext.grading.ex02_mu",
+                "structured singular value: full-block mu, D-scaling upper bound, destabilising Delta, "
+                "uncertain spring as an LFT, peak over frequency"),
+    "ex03_free_decay": ("mutext.grading.ex03_free_decay",
+                        "free-decay identification of a cart: frequency, damping ratio, mass, stiffness, "
+                        "damping coefficient"),
     "ex04_beam_element": ("mutext.grading.ex04_beam_element",
                           "Euler-Bernoulli beam elements: element matrices, assembly, natural frequencies, "
                           "convergence"),
