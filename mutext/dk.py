@@ -66,7 +66,6 @@ References
 """
 from __future__ import annotations
 
-import contextlib
 import sys
 import time
 from dataclasses import dataclass, field
@@ -76,23 +75,12 @@ import numpy as np
 
 from .errors import IllPosedError, InfeasibleError, ModelError, SolverError
 from .hinf import hinfsyn, slycot_hinfsyn
-from .lti import as_ss, freqresp, lft_lower, ss
+from .lti import as_ss, blas_single_thread, freqresp, lft_lower, ss
 from .mu import BlockStructure, MuSweep, default_grid, mu_sweep, mu_upper
 
 __all__ = ["DScaleFit", "fit_dscale", "fit_dscale_auto", "scaled_plant", "DKResult", "dk_iteration"]
 
 
-def _single_thread_blas():
-    """Limit BLAS to one thread where threadpoolctl is available.
-
-    Every matrix here is small; with several BLAS threads on a busy machine a
-    6x6 solve can cost milliseconds of spinning instead of microseconds.
-    """
-    try:
-        from threadpoolctl import threadpool_limits
-    except ImportError:  # pragma: no cover - optional
-        return contextlib.nullcontext()
-    return threadpool_limits(1)
 
 
 # ----------------------------------------------------------------------------
@@ -530,15 +518,17 @@ def _sweep_upper(H, S: BlockStructure, X0=None, tol: float = 1e-6, max_iter: int
     nw = H.shape[0]
     m = len(S)
     if X0 is None:
-        # Osborne balancing of the block-norm matrices
+        # Osborne balancing of the block-norm matrices (off-diagonal blocks
+        # only; the floor keeps blocks that are zero from driving d to 0 or inf)
         Bn = np.empty((nw, m, m))
         for i in range(m):
             for j in range(m):
                 Bn[:, i, j] = np.linalg.norm(H[:, S.col_slices[i], S.row_slices[j]], axis=(1, 2))
+        floor = 1e-100 + 1e-12 * Bn.max(axis=(1, 2), keepdims=True)
         Bn[:, np.arange(m), np.arange(m)] = 0.0
-        Bn += 1e-300 + 1e-14 * Bn.max(axis=(1, 2), keepdims=True)
+        Bn += floor
         X0 = np.zeros((nw, m))
-        for _ in range(30):
+        for _ in range(30 if m > 1 else 0):
             for i in range(m):
                 e = np.exp(X0)
                 r = np.sqrt(np.sum((Bn[:, i, :] / e) ** 2, axis=1))
@@ -611,6 +601,11 @@ def _intervals(H, S: BlockStructure, X, level: float, reach: float, steps: int =
     return lo, hi
 
 
+#: a fit is good enough when it stays inside half of its admissible band (weighted
+#: error <= 0.5); 1.0 leaves no slack for several blocks deviating together
+_GOOD = 0.5
+
+
 def _d_step(omega, H, S: BlockStructure, X, upper, max_order: int, fit_tol: float,
             budget: int, reach: float = np.log(100.0), rounds: int = 4):
     """Rational scalings for the next K step (see the module docstring).
@@ -652,7 +647,7 @@ def _d_step(omega, H, S: BlockStructure, X, upper, max_order: int, fit_tol: floa
         # a fit counts as good when it stays inside half of its admissible band
         while True:
             used = sum(f.order * cost[k] for k, f in enumerate(cur))
-            cand = [k for k in range(m - 1) if cur[k].error > 0.5 and requested[k] < max_order
+            cand = [k for k in range(m - 1) if cur[k].error > _GOOD and requested[k] < max_order
                     and used - cur[k].order * cost[k] + (requested[k] + 1) * cost[k] <= budget]
             if not cand:
                 break
@@ -871,9 +866,8 @@ def _final_analysis(CL, S: BlockStructure, grid, final_points: int, dg: bool, np
 def dk_iteration(P, structure: BlockStructure, nmeas: int, ncon: int, *, omega=None,
                  max_iter: int = 8, max_order: int = 4, max_states: int | None = None,
                  fit_tol: float = 0.02, rel_improvement: float = 0.01, patience: int = 1,
-                 grid_points: int = 80,
-                 final_points: int = 200, dg: bool = True, synthesis=None,
-                 out=sys.stdout) -> DKResult:
+                 grid_points: int = 80, final_points: int = 200, dg: bool = True,
+                 synthesis=None, out=sys.stdout) -> DKResult:
     r"""D-K iteration for robust performance.
 
     Parameters
@@ -952,6 +946,10 @@ def dk_iteration(P, structure: BlockStructure, nmeas: int, ncon: int, *, omega=N
         raise ModelError(f"max_states must be an integer >= the plant order {P.nstates}, got {max_states!r}")
     if not fit_tol > 0:
         raise ModelError(f"fit_tol must be positive, got {fit_tol!r}")
+    for name, v, least in (("patience", patience, 1), ("grid_points", grid_points, 3),
+                           ("final_points", final_points, 3)):
+        if not (isinstance(v, (int, np.integer)) and v >= least):
+            raise ModelError(f"{name} must be an integer >= {least}, got {v!r}")
     if omega is not None:
         omega = np.unique(np.asarray(omega, dtype=float).ravel())
         if omega.size == 0:
@@ -966,7 +964,7 @@ def dk_iteration(P, structure: BlockStructure, nmeas: int, ncon: int, *, omega=N
         synth = synthesis
     else:
         raise ModelError(f"synthesis must be 'lmi', 'riccati' or a callable, got {synthesis!r}")
-    with _single_thread_blas():
+    with blas_single_thread():
         return _dk(P, S, nmeas, ncon, omega, max_iter, max_order, max_states - P.nstates, fit_tol,
                    rel_improvement, patience, grid_points, final_points, dg, synth, out, t0)
 
@@ -1007,8 +1005,9 @@ def _dk(P, S, nmeas, ncon, grid, max_iter, max_order, budget, fit_tol, rel_impro
             notes.append(f"iteration {it}: the K step failed ({exc}); kept iteration {best[4]}")
             history.append({"iteration": it, "gamma": float("nan"), "mu": float("nan"),
                             "orders": orders, "fit_peak": fit_peak, "controller_order": None,
-                            "seconds": time.perf_counter() - ti, "error": str(exc)})
-            _print(out, f"{it:>4}  K step failed: {exc}")
+                            "method": None, "seconds": time.perf_counter() - ti, "error": str(exc)})
+            msg = str(exc)
+            _print(out, f"{it:>4}  K step failed: {msg[:90] + ' ...' if len(msg) > 90 else msg}")
             break
         K = as_ss(res.K, "K")
         CL = lft_lower(P, K, nmeas, ncon)
@@ -1020,6 +1019,7 @@ def _dk(P, S, nmeas, ncon, grid, max_iter, max_order, budget, fit_tol, rel_impro
             if best is None:
                 raise exc
             notes.append(str(exc))
+            _print(out, f"{it:>4}  {exc}")
             break
         H = np.moveaxis(freqresp(CL, grid), -1, 0)
         upper, Xd = _sweep_upper(H, Sc, Xd)
@@ -1033,7 +1033,8 @@ def _dk(P, S, nmeas, ncon, grid, max_iter, max_order, budget, fit_tol, rel_impro
         if best is None or mu_pk < best[0]:
             best = (mu_pk, K, CL, list(fits), it)
         stall = 0 if progress else stall + 1
-        stop = stall >= patience or it == max_iter
+        # a single block has no scaling to fit: the first K step is the answer
+        stop = stall >= patience or it == max_iter or len(S) == 1
         if not stop:
             # D step on the new closed loop
             try:
@@ -1051,7 +1052,8 @@ def _dk(P, S, nmeas, ncon, grid, max_iter, max_order, budget, fit_tol, rel_impro
     mu_pk, K, CL, used_fits, best_it = best
     final, low, low_c, mu_dg = _final_analysis(CL, S, grid, final_points, dg)
     _print(out, f"best: iteration {best_it}, controller order {K.nstates}; fine grid: "
-                f"{low:.4f} <= mu <= {final.peak_upper:.4f} (real parameters as complex)"
+                f"{low:.4f} <= mu <= {final.peak_upper:.4f}"
+                + (" (real parameters as complex)" if S.has_real else "")
                 + (f", {mu_dg:.4f} with D-G scalings" if S.has_real and dg else ""))
     return DKResult(K=K, CL=CL, mu_upper=float(final.peak_upper), mu_upper_dg=mu_dg, mu_lower=low,
                     mu_lower_complex=low_c, peak_frequency=float(final.peak_frequency),

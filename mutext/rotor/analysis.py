@@ -44,7 +44,6 @@ Rotating Machines*, Cambridge University Press, 2010, ch. 3 and 5.
 """
 from __future__ import annotations
 
-import contextlib
 from dataclasses import dataclass, field
 from typing import Sequence
 
@@ -52,25 +51,12 @@ import numpy as np
 import scipy.linalg as sla
 
 from ..errors import ModelError
-from ..lti import mck_to_ss
+from ..lti import blas_single_thread, mck_to_ss
 
 __all__ = ["Modes", "FRF", "Campbell", "modes", "natural_frequencies", "campbell", "frf",
            "state_space", "whirl_index", "blas_single_thread"]
 
 
-def blas_single_thread():
-    """Context manager limiting BLAS/LAPACK to one thread, if ``threadpoolctl`` is installed.
-
-    The matrices here are small (hundreds of DOFs): a multi-threaded BLAS
-    gains nothing on them and, on a shared or oversubscribed machine, loses
-    10-20x to thread contention.  Without ``threadpoolctl`` this does nothing
-    (set ``OPENBLAS_NUM_THREADS=1`` in the environment instead).
-    """
-    try:
-        from threadpoolctl import threadpool_limits
-    except ImportError:
-        return contextlib.nullcontext()
-    return threadpool_limits(limits=1, user_api="blas")
 
 
 @dataclass

@@ -1,0 +1,8 @@
+"""Test-session settings: BLAS on one thread.
+
+The matrices under test are small; on a 2-core CI machine a multi-threaded
+BLAS only adds threads that spin against pytest and the solvers' own work.
+"""
+from threadpoolctl import threadpool_limits
+
+_limits = threadpool_limits(limits=1, user_api="blas")
