@@ -567,10 +567,15 @@ def impedance_response(coeffs: dict, omega) -> np.ndarray:
     return coeffs.get("dk", 0.0) + 1j * w * coeffs.get("dc", 0.0) - w ** 2 * coeffs.get("dm", 0.0)
 
 
-def relative_error(K, reference, omega) -> float:
-    r"""RMS over ``omega`` of :math:`|K(j\omega) - D(j\omega)| / |D(j\omega)|`, with
-    ``reference`` a dict ``{"dm", "dc", "dk"}`` or a response array on ``omega``."""
+def relative_error(K, reference, omega, weight=None) -> float:
+    r"""Weighted RMS over ``omega`` of :math:`|K(j\omega) - D(j\omega)| / |D(j\omega)|`, with
+    ``reference`` a dict ``{"dm", "dc", "dk"}`` or a response array on ``omega``.
+
+    With ``weight`` the sensitivity :math:`|s(\omega)|` of :func:`identifiable_band`
+    (as :attr:`ImpedanceFit.weight` holds it), frequencies count by how strongly the
+    measurement constrains ``K`` there; without, equally."""
     omega = np.asarray(omega, float)
     D = impedance_response(reference, omega) if isinstance(reference, dict) else np.asarray(reference, complex)
     Kj = freqresp(as_ss(K), omega)[0, 0]
-    return float(np.sqrt(np.mean(np.abs(Kj - D) ** 2 / np.abs(D) ** 2)))
+    w2 = np.ones_like(omega) if weight is None else np.asarray(weight, float) ** 2
+    return float(np.sqrt(np.sum(w2 * np.abs(Kj - D) ** 2 / np.abs(D) ** 2) / np.sum(w2)))

@@ -42,7 +42,8 @@ def solve(trial: str = "1a", out=sys.stderr):
         "fit_residual": res.fit.residual,
         "band_rad_s": list(res.fit.band),
         "Du": dict(tr.Du),
-        "K_rel_error": relative_error(res.K, tr.Du, band),
+        "K_rel_error": relative_error(res.K, tr.Du, band, weight=res.fit.weight),
+        "K_rel_error_unweighted": relative_error(res.K, tr.Du, band),
         "controller_order": res.K.nstates,
         "tries": [{"Wz": t.Wz, "mu": t.mu_upper} for t in res.tries],
         "thesis": {"Wz": tr.Wz, "mu": tr.mu},
@@ -80,7 +81,7 @@ def run(args) -> int:
         print(f"plot saved: {path}", file=sys.stderr if args.json else sys.stdout)
     if args.json:
         from ..cli import print_json
-        print_json({k: r[k] for k in ("trial", "mu", "mu_lower", "Wz", "fit", "fit_sigma", "fit_residual", "Du", "K_rel_error",
+        print_json({k: r[k] for k in ("trial", "mu", "mu_lower", "Wz", "fit", "fit_sigma", "fit_residual", "Du", "K_rel_error", "K_rel_error_unweighted",
                                       "controller_order", "tries", "thesis", "band_rad_s", "seconds")})
         return 0
     res = r["result"]
@@ -92,7 +93,8 @@ def run(args) -> int:
     print(f"reading of K: {res.fit.description}")
     d = tr.Du
     print(f"expected D_u: mass {d['dm']:+.4g} kg, damper {d['dc']:+.4g} N s/m, spring {d['dk']:+.4g} N/m")
-    print(f"relative error of K against D_u on the band (RMS): {r['K_rel_error']:.2%}")
+    print(f"relative error of K against D_u on the band (RMS weighted by the sensitivity): "
+          f"{r['K_rel_error']:.2%} (unweighted {r['K_rel_error_unweighted']:.2%})")
     for n in r["notes"]:
         print(f"note: {n}")
     print(f"time: {r['seconds']:.1f} s")
