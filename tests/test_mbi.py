@@ -159,6 +159,9 @@ def test_regularization_does_not_change_the_identified_dynamics():
     a = identify(**args, Wz=tr.Wz, regularization=1e-4, out=None, max_tries=1)
     b = identify(**args, Wz=tr.Wz, regularization=5e-5, out=None, max_tries=1)
     band = a.fit.omega
-    Ka, Kb = freqresp(a.K, band)[0, 0], freqresp(b.K, band)[0, 0]
-    assert np.max(np.abs(Ka - Kb) / np.abs(Ka)) < 0.01
+    # K where the measurement constrains it (weighted by the sensitivity); outside
+    # that, K is free and may move by ~10 % between the two runs
+    Ka = freqresp(a.K, band)[0, 0]
+    assert relative_error(b.K, Ka, band, weight=a.fit.weight) < 0.01
+    assert b.fit.dk == pytest.approx(a.fit.dk, rel=0.01)
     assert abs(a.mu_upper - b.mu_upper) < 0.01
