@@ -57,7 +57,8 @@ from .errors import IllPosedError, ModelError
 from .lti import as_ss, check_finite, freqresp, is_stable, lft_lower, ss
 from .mu import Block, BlockStructure
 
-__all__ = ["MBIPlant", "mbi_plant", "ImpedanceFit", "fit_impedance", "WzTry", "MBIResult", "identify"]
+__all__ = ["MBIPlant", "mbi_plant", "ImpedanceFit", "fit_impedance", "WzTry", "MBIResult", "identify",
+           "WzFloor", "wz_floor"]
 
 
 def _index(sys, name, kind, what):
@@ -421,6 +422,8 @@ class MBIResult:
         The final D-K run.
     seconds : float
     notes : list of str
+    floor : WzFloor
+        The certified lower bound on any achievable ``Wz`` (:func:`wz_floor`).
     """
     K: ct.StateSpace
     Wz: float
@@ -434,6 +437,7 @@ class MBIResult:
     seconds: float
     omega: np.ndarray = field(repr=False, default=None)
     notes: list = field(default_factory=list)
+    floor: WzFloor | None = None
 
     def error(self, true_system, omega=None) -> np.ndarray:
         """|x_true - x_controlled| (output unit per input unit) of a true system over ``omega``."""
@@ -443,6 +447,106 @@ class MBIResult:
         i = list(T.input_labels).index(pr["excitation"])
         o = list(T.output_labels).index(pr["measurement"])
         return np.abs(freqresp(T, omega)[o, i] - freqresp(self.controlled, omega)[0, 0])
+
+
+@dataclass
+class WzFloor:
+    r"""A certified lower bound on the achievable :math:`W_z` (:func:`wz_floor`).
+
+    Attributes
+    ----------
+    value : float
+        No controller can certify robust performance (:math:`\mu \le 1`) with a
+        smaller :math:`W_z` (output unit).
+    omega : float
+        Frequency (rad/s) where the true systems spread most.
+    deltas : tuple of numpy.ndarray
+        The two normalised perturbations whose responses are farthest apart there.
+    samples : int
+        Number of true systems compared.
+    """
+    value: float
+    omega: float
+    deltas: tuple
+    samples: int
+
+
+def _delta_samples(m: int, rng=0) -> np.ndarray:
+    """Perturbations covering the box [-1, 1]^m: a full grid for few parameters, else
+    all vertices (up to 2^8) plus random interior points."""
+    if m == 0:
+        return np.zeros((1, 0))
+    if m <= 5:
+        levels = np.linspace(-1.0, 1.0, 5 if m <= 3 else 3)
+        return np.array(np.meshgrid(*[levels] * m, indexing="ij")).reshape(m, -1).T
+    r = np.random.default_rng(rng)
+    verts = (r.choice((-1.0, 1.0), size=(256, m)) if m > 8
+             else np.array(np.meshgrid(*[[-1.0, 1.0]] * m, indexing="ij")).reshape(m, -1).T)
+    return np.vstack([np.zeros((1, m)), verts, r.uniform(-1.0, 1.0, size=(64, m))])
+
+
+def wz_floor(true, *, excitation: str, measurement: str, Ww: float = 1.0, omega=None,
+             rng=0) -> WzFloor:
+    r"""The smallest :math:`W_z` that any identification can certify, from the spread of the true set.
+
+    Robust performance at :math:`W_z` means that one controlled response
+    :math:`x_c(j\omega)` is within :math:`W_z/W_w` of the response
+    :math:`x_t(\delta, j\omega)` of every true system in the uncertainty set.
+    Two true systems :math:`\delta_1, \delta_2` whose responses differ by
+    :math:`d` therefore force :math:`W_z \ge W_w d/2`, whatever the controller:
+
+    .. math::
+        W_z \ge W_w \max_\omega \tfrac12 \max_{\delta_1, \delta_2}
+        |x_t(\delta_1, j\omega) - x_t(\delta_2, j\omega)|.
+
+    Any finite set of samples and frequencies gives a valid (lower) bound; the
+    grid is refined around the widest spread.  A true system without
+    uncertainty gives 0.
+
+    Parameters
+    ----------
+    true : mutext.uncertain.UncertainModel or control.StateSpace
+    excitation, measurement : str
+        The shared input and measured output.
+    Ww : float
+        Size of the excitation.
+    omega : array_like, optional
+        Frequencies (rad/s); default: two decades around the true system's poles.
+
+    Returns
+    -------
+    WzFloor
+    """
+    from .uncertain import UncertainModel
+    if not isinstance(true, UncertainModel):
+        return WzFloor(0.0, float("nan"), (), 1)
+    nom = true.nominal()
+    i = _index(nom, excitation, "input", "true system")
+    o = _index(nom, measurement, "output", "true system")
+    if omega is None:
+        poles = np.abs(np.linalg.eigvals(np.asarray(nom.A, float)))
+        poles = poles[poles > 0]
+        lo, hi = (poles.min() / 10, poles.max() * 10) if poles.size else (1e-2, 1e2)
+        omega = np.logspace(np.log10(lo), np.log10(hi), 400)
+    omega = np.asarray(omega, float)
+    if omega.size == 0:
+        raise ModelError("wz_floor: the frequency grid is empty")
+    deltas = _delta_samples(len(true.params), rng)
+    systems = [true.close(d) for d in deltas]
+
+    def spread(w):
+        R = np.array([freqresp(S, w)[o, i] for S in systems])        # (samples, nw)
+        dist = np.abs(R[:, None, :] - R[None, :, :])
+        k = int(np.argmax(dist.max(axis=(0, 1))))
+        a, b = np.unravel_index(np.argmax(dist[:, :, k]), dist.shape[:2])
+        return dist[a, b, k] / 2, w[k], (a, b)
+
+    half, wk, pair = spread(omega)
+    for _ in range(2):       # lightly damped resonances: zoom in around the widest spread
+        h2, w2, p2 = spread(wk * np.logspace(-0.02, 0.02, 81))
+        if h2 > half:
+            half, wk, pair = h2, w2, p2
+    return WzFloor(float(Ww * half), float(wk), (deltas[pair[0]], deltas[pair[1]]), len(systems))
 
 
 def _default_omega(plant: MBIPlant, n: int = 300):
@@ -463,7 +567,9 @@ def identify(true, engineering, *, excitation: str, measurement: str, control_in
     too tight (raise :math:`W_z`), :math:`\mu < 1 - \text{tol}` too loose (lower
     it).  Each new value comes from the log-log secant through the last two tries
     (:math:`\mu` scales roughly like :math:`W_z^{-1}`), kept inside the bracket
-    once one is known.  Accepted: :math:`1 - \text{tol} \le \mu \le 1`.
+    once one is known.  Accepted: :math:`1 - \text{tol} \le \mu \le 1`.  No try goes
+    below the floor of :func:`wz_floor`, under which :math:`\mu > 1` for every
+    controller.
 
     Parameters
     ----------
@@ -471,7 +577,8 @@ def identify(true, engineering, *, excitation: str, measurement: str, control_in
         As in :func:`mbi_plant`.
     Wz : float, optional
         First value to try (default: 1 % of the peak open-loop error
-        :math:`W_w|x_t - x_e|`).
+        :math:`W_w|x_t - x_e|`, or 1.1 times the floor if that is larger; a
+        value at or below the floor is raised to it, with a note).
     tol : float
         Accepted distance of mu below 1.
     max_tries : int
@@ -497,6 +604,14 @@ def identify(true, engineering, *, excitation: str, measurement: str, control_in
     omega = _default_omega(probe) if omega is None else np.asarray(omega, float)
     if omega.size == 0:
         raise ModelError("identify: the frequency grid is empty")
+    if not np.all(np.isfinite(omega)) or omega.min() <= 0:
+        raise ModelError("identify: the frequency grid must hold positive, finite frequencies (rad/s)")
+    modes = np.abs(np.linalg.eigvals(np.asarray(probe.P.A, float)))
+    modes = modes[modes > 0]
+    if modes.size and (omega.max() < modes.min() / 10 or omega.min() > modes.max() * 10):
+        raise ModelError(f"identify: no frequency overlap: the grid spans {omega.min():.4g}-{omega.max():.4g} "
+                         f"rad/s, the systems' modes lie at {modes.min():.4g}-{modes.max():.4g} rad/s "
+                         "(a decade either side is needed to compare their responses)")
     diff = float(np.max(np.abs(freqresp(probe.P, omega)[probe.nunc, probe.nunc])))
     E = probe.engineering
     ref = float(np.max(np.abs(freqresp(E, omega)[list(E.output_labels).index(measurement),
@@ -504,12 +619,23 @@ def identify(true, engineering, *, excitation: str, measurement: str, control_in
     if diff <= 1e-9 * ref:
         raise IllPosedError("the true and engineering responses are identical on the grid "
                             f"(largest difference {diff:.3g} against {ref:.3g}): there is nothing to identify")
+    floor = wz_floor(true, excitation=excitation, measurement=measurement, Ww=Ww, omega=omega)
+    start_notes = []
     if Wz is None:
-        Wz = 0.01 * diff
+        Wz = max(0.01 * diff, 1.1 * floor.value)
+    elif Wz <= floor.value:
+        start_notes.append(f"the first W_z {Wz:.4g} is below the floor {floor.value:.4g} set by the "
+                           f"spread of the true systems at {floor.omega:.4g} rad/s (no controller can "
+                           f"reach it); the search started at {1.1 * floor.value:.4g}")
+        Wz = 1.1 * floor.value
+    if out is not None and floor.value > 0:
+        print(f"[mbi] W_z floor {floor.value:.4g} (spread of {floor.samples} true systems at "
+              f"{floor.omega:.4g} rad/s)", file=out, flush=True)
     opts = {"max_iter": 4, "out": None if out is None else out}
     opts.update(dk_options or {})
     tries, runs = [], []
-    lo = hi = None      # Wz with mu > 1 (too tight) / mu <= 1
+    lo = floor.value or None    # Wz with mu > 1 (too tight; the floor is one) / mu <= 1
+    hi = None
     target = 1.0 - tol / 2
     for k in range(max_tries):
         plant = mbi_plant(true, engineering, Wz=Wz, **kw)
@@ -540,11 +666,13 @@ def identify(true, engineering, *, excitation: str, measurement: str, control_in
         if lo is not None and hi is not None:
             if not lo < new < hi:
                 new = np.sqrt(lo * hi)
+        elif lo is not None and new <= lo:
+            new = lo * 1.1
         Wz = float(new)
     ok = [i for i, t in enumerate(tries) if t.mu_upper <= 1.0]
     best = min(ok, key=lambda i: tries[i].Wz) if ok else int(np.argmin([t.mu_upper for t in tries]))
     plant, res = runs[best]
-    notes = []
+    notes = start_notes
     if not 1.0 - tol <= tries[best].mu_upper <= 1.0:
         notes.append(f"W_z search stopped after {len(tries)} tries without mu in [{1 - tol:.3g}, 1]; "
                      f"returning the try with {'the smallest W_z at mu <= 1' if ok else 'the lowest mu (> 1)'}")
@@ -558,7 +686,7 @@ def identify(true, engineering, *, excitation: str, measurement: str, control_in
         band = np.ones_like(band)
     fit = fit_impedance(res.K, omega[band], weight=sens[band])
     return MBIResult(res.K, tries[best].Wz, tries[best].mu_upper, tries[best].mu_lower, tries, plant, fit,
-                     controlled_engineering(plant, res.K), res, time.perf_counter() - t0, omega, notes)
+                     controlled_engineering(plant, res.K), res, time.perf_counter() - t0, omega, notes, floor)
 
 
 def impedance_response(coeffs: dict, omega) -> np.ndarray:
@@ -569,13 +697,14 @@ def impedance_response(coeffs: dict, omega) -> np.ndarray:
 
 def relative_error(K, reference, omega, weight=None) -> float:
     r"""Weighted RMS over ``omega`` of :math:`|K(j\omega) - D(j\omega)| / |D(j\omega)|`, with
-    ``reference`` a dict ``{"dm", "dc", "dk"}`` or a response array on ``omega``.
+    ``K`` a system or a response array on ``omega`` and ``reference`` a dict
+    ``{"dm", "dc", "dk"}`` or a response array on ``omega``.
 
     With ``weight`` the sensitivity :math:`|s(\omega)|` of :func:`identifiable_band`
     (as :attr:`ImpedanceFit.weight` holds it), frequencies count by how strongly the
     measurement constrains ``K`` there; without, equally."""
     omega = np.asarray(omega, float)
     D = impedance_response(reference, omega) if isinstance(reference, dict) else np.asarray(reference, complex)
-    Kj = freqresp(as_ss(K), omega)[0, 0]
+    Kj = np.asarray(K, complex) if isinstance(K, np.ndarray) else freqresp(as_ss(K), omega)[0, 0]
     w2 = np.ones_like(omega) if weight is None else np.asarray(weight, float) ** 2
     return float(np.sqrt(np.sum(w2 * np.abs(Kj - D) ** 2 / np.abs(D) ** 2) / np.sum(w2)))

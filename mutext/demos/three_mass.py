@@ -14,7 +14,7 @@ import sys
 import time
 
 from ..examples import three_mass
-from ..mbi import identify, relative_error
+from ..mbi import identify, impedance_response, relative_error
 
 
 def add_arguments(p):
@@ -44,6 +44,10 @@ def solve(trial: str = "1a", out=sys.stderr):
         "Du": dict(tr.Du),
         "K_rel_error": relative_error(res.K, tr.Du, band, weight=res.fit.weight),
         "K_rel_error_unweighted": relative_error(res.K, tr.Du, band),
+        # how far D_u itself moves across the uncertainty box, on the same band and weights
+        "Du_spread": max(relative_error(impedance_response(d, band), tr.Du, band, weight=res.fit.weight)
+                         for d in three_mass.du_box(tr)),
+        "Wz_floor": res.floor.value,
         "controller_order": res.K.nstates,
         "tries": [{"Wz": t.Wz, "mu": t.mu_upper} for t in res.tries],
         "thesis": {"Wz": tr.Wz, "mu": tr.mu},
@@ -82,11 +86,13 @@ def run(args) -> int:
     if args.json:
         from ..cli import print_json
         print_json({k: r[k] for k in ("trial", "mu", "mu_lower", "Wz", "fit", "fit_sigma", "fit_residual", "Du", "K_rel_error", "K_rel_error_unweighted",
-                                      "controller_order", "tries", "thesis", "band_rad_s", "seconds")})
+                                      "Du_spread", "Wz_floor", "controller_order", "tries", "thesis", "band_rad_s", "seconds")})
         return 0
     res = r["result"]
     print(f"W_z = {r['Wz']:.4g} m   mu <= {r['mu']:.4f} (lower bound {r['mu_lower']:.4f});"
           f" thesis: W_z = {tr.Wz:g} m, mu <= {tr.mu}")
+    print(f"floor: no controller can certify W_z below {r['Wz_floor']:.4g} m (spread of the true rigs"
+          f" at {res.floor.omega:.3g} rad/s)")
     print("tries: " + ", ".join(f"W_z={t['Wz']:.4g} -> mu={t['mu']:.4f}" for t in r["tries"]))
     print(f"controller order {r['controller_order']}; identifiable band "
           f"{r['band_rad_s'][0]:.3g}-{r['band_rad_s'][1]:.3g} rad/s")
@@ -94,7 +100,8 @@ def run(args) -> int:
     d = tr.Du
     print(f"expected D_u: mass {d['dm']:+.4g} kg, damper {d['dc']:+.4g} N s/m, spring {d['dk']:+.4g} N/m")
     print(f"relative error of K against D_u on the band (RMS weighted by the sensitivity): "
-          f"{r['K_rel_error']:.2%} (unweighted {r['K_rel_error_unweighted']:.2%})")
+          f"{r['K_rel_error']:.2%} (unweighted {r['K_rel_error_unweighted']:.2%}); D_u itself moves by up to "
+          f"{r['Du_spread']:.2%} across the uncertainty box")
     for n in r["notes"]:
         print(f"note: {n}")
     print(f"time: {r['seconds']:.1f} s")

@@ -24,7 +24,7 @@ from ..lti import hinf_norm, lft_lower
 
 def add_arguments(p):
     p.add_argument("--xmax", type=float, default=0.035,
-                   help="allowed displacement of m1 in m (thesis: 0.035, relaxed to 0.041)")
+                   help="allowed displacement of m1 in m (thesis: 0.035, relaxed to 0.041; mu < 1 here from about 0.043)")
     p.add_argument("--json", action="store_true", help="print one JSON object instead of a report")
     p.add_argument("--max-iter", type=int, default=6, help="largest number of D-K iterations (default 6)")
 
@@ -121,6 +121,8 @@ def run(args) -> int:
           f"at delta = {out['corner_worst']}")
     verdict = "met" if out["mu_upper_dg"] < 1 else "not guaranteed"
     print(f"robust performance (mu < 1): {verdict}")
+    if out["mu_upper_dg"] >= 1:
+        print("hint: relax the bound (--xmax); in this version of the problem mu drops below 1 near 0.043 m")
     for n in out["notes"]:
         print(f"note: {n}")
     print(f"time: {out['seconds']:.1f} s")

@@ -133,6 +133,20 @@ def true_model(trial: Trial):
                          dof_names=["x1", "x2", "x3"])
 
 
+def du_box(trial: Trial) -> list[dict]:
+    """D_u of the true rigs at the corners of the uncertainty box: what the
+    identification may legitimately return, since any of them is consistent with
+    the (uncertain) measurement."""
+    U = true_model(trial)
+    e = trial.engineering
+    out = []
+    for d in np.array(np.meshgrid(*[[-1.0, 1.0]] * len(U.params), indexing="ij")).reshape(len(U.params), -1).T:
+        v = {n: getattr(trial.true, n) for n in ("m3", "c3", "k3")}
+        v.update(U.values(d))
+        out.append({"dm": v["m3"] - e.m3, "dc": v["c3"] - e.c3, "dk": v["k3"] - e.k3})
+    return out
+
+
 def mbi_arguments(trial: Trial) -> dict:
     """Keyword arguments of :func:`mutext.mbi.identify` for a trial (excitation and
     measurement at cart 1, the unknown dynamics at cart 3, unit excitation force)."""
