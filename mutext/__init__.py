@@ -8,9 +8,25 @@ lti
 hinf
     H-infinity synthesis written as linear matrix inequalities (cvxpy + Clarabel),
     with an independent check of every controller.
+uncertain
+    Uncertain physical parameters pulled out of M, C, K models as LFTs.
+mu
+    Structured singular value: D / D-G upper bounds (LMI, Osborne), lower bounds.
+dk
+    D-K iteration (mu-synthesis) with rational D-scale fits.
+mbi
+    Model-based identification: the unmodeled dynamics as a mu-controller.
+frfit
+    Stable rational models of measured frequency responses (vector fitting).
+rig
+    Virtual test rig and FRF files.
+sysid
+    Parameters from free-decay records.
+rotor
+    Finite-element rotors, cracks, reduction and tuning (CasADi, IPOPT).
 examples
-    The thesis examples (two-mass system, ...), shared by the book, demos,
-    exercises and tests.
+    The thesis examples (two-mass, three-mass, rotor), shared by the book,
+    demos, exercises and tests.
 """
 
 from .errors import (IllPosedError, InfeasibleError, ModelError, MutextError,

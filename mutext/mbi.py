@@ -58,7 +58,7 @@ from .lti import as_ss, check_finite, freqresp, is_stable, lft_lower, ss
 from .mu import Block, BlockStructure
 
 __all__ = ["MBIPlant", "mbi_plant", "ImpedanceFit", "fit_impedance", "WzTry", "MBIResult", "identify",
-           "WzFloor", "wz_floor"]
+           "WzFloor", "wz_floor", "true_from_frf"]
 
 
 def _index(sys, name, kind, what):
@@ -424,6 +424,9 @@ class MBIResult:
     notes : list of str
     floor : WzFloor
         The certified lower bound on any achievable ``Wz`` (:func:`wz_floor`).
+    measured_fit : mutext.frfit.RationalFit or None
+        When the true system was a measured FRF: the rational model that stood in
+        for it, with its residual.
     """
     K: ct.StateSpace
     Wz: float
@@ -438,6 +441,7 @@ class MBIResult:
     omega: np.ndarray = field(repr=False, default=None)
     notes: list = field(default_factory=list)
     floor: WzFloor | None = None
+    measured_fit: object = None
 
     def error(self, true_system, omega=None) -> np.ndarray:
         """|x_true - x_controlled| (output unit per input unit) of a true system over ``omega``."""
@@ -556,6 +560,46 @@ def _default_omega(plant: MBIPlant, n: int = 300):
     return np.logspace(np.log10(lo), np.log10(hi), n)
 
 
+def true_from_frf(frf, engineering, *, excitation: str, measurement: str, tol: float = 0.02,
+                  max_order: int = 24):
+    r"""A state-space stand-in for a measured FRF, to serve as the true system.
+
+    The measured response (:class:`mutext.rig.FRF`, SI units, the excitation
+    and measurement of the engineering model) is fitted by a stable rational
+    model (:func:`mutext.frfit.fit_frf_auto`); its inputs and outputs are
+    named ``excitation`` and ``measurement``.
+
+    Raises
+    ------
+    ModelError
+        No frequency overlap: none of the engineering model's modes lies in the
+        measured band (the identification would compare the two where neither
+        says anything about the other), or unusable data.
+
+    Returns
+    -------
+    (control.StateSpace, mutext.frfit.RationalFit)
+    """
+    from .frfit import fit_frf_auto
+    E = as_ss(engineering, "engineering model")
+    f = np.asarray(frf.freq_hz, float)
+    if f.size < 4:
+        raise ModelError(f"measured FRF{_source(frf)}: need at least 4 frequencies, got {f.size}")
+    modes = np.abs(np.linalg.eigvals(np.asarray(E.A, float))) / (2 * np.pi) if E.nstates else np.zeros(0)
+    modes = np.unique(np.round(modes[modes > 0], 9))
+    if modes.size and not np.any((modes >= f.min()) & (modes <= f.max())):
+        raise ModelError(f"measured FRF{_source(frf)}: no frequency overlap: it covers {f.min():.4g}-{f.max():.4g} Hz, "
+                         f"the engineering model's modes lie at {', '.join(f'{m:.4g}' for m in modes[:6])} Hz")
+    fit = fit_frf_auto(2 * np.pi * f, frf.response, tol=tol, max_order=max_order)
+    sys = ss(fit.system.A, fit.system.B, fit.system.C, fit.system.D, inputs=[excitation], outputs=[measurement])
+    return sys, fit
+
+
+def _source(frf) -> str:
+    src = getattr(frf, "source", None)
+    return f" {src}" if src else ""
+
+
 def identify(true, engineering, *, excitation: str, measurement: str, control_input: str,
              control_output: str, Ww: float = 1.0, Wz: float | None = None, tol: float = 0.05,
              max_tries: int = 8, regularization: float | None = 1e-4, omega=None,
@@ -573,7 +617,11 @@ def identify(true, engineering, *, excitation: str, measurement: str, control_in
 
     Parameters
     ----------
-    true, engineering, excitation, measurement, control_input, control_output, Ww, regularization
+    true : control.StateSpace, mutext.uncertain.UncertainModel or mutext.rig.FRF
+        As in :func:`mbi_plant`, or a measured FRF from the excitation to the
+        measurement (SI units), which :func:`true_from_frf` fits by a stable
+        rational model; the grid is then the measured frequencies.
+    engineering, excitation, measurement, control_input, control_output, Ww, regularization
         As in :func:`mbi_plant`.
     Wz : float, optional
         First value to try (default: 1 % of the peak open-loop error
@@ -597,7 +645,26 @@ def identify(true, engineering, *, excitation: str, measurement: str, control_in
         lowest mu) is returned with a note saying so.
     """
     from .dk import dk_iteration
+    from .rig import FRF
     t0 = time.perf_counter()
+    measured_fit = None
+    if isinstance(true, FRF):
+        measured = true
+        true, measured_fit = true_from_frf(measured, engineering, excitation=excitation, measurement=measurement)
+        band = 2 * np.pi * np.asarray(measured.freq_hz, float)
+        if omega is None:
+            omega = band
+        else:
+            omega = np.asarray(omega, float)
+            omega = omega[(omega >= band.min()) & (omega <= band.max())]
+            if omega.size == 0:
+                raise ModelError(f"identify: no frequency overlap between the grid and the measured FRF "
+                                 f"({band.min():.4g}-{band.max():.4g} rad/s)")
+        if out is not None:
+            print(f"[mbi] measured FRF: {measured.freq_hz.size} frequencies, "
+                  f"{measured.freq_hz.min():.4g}-{measured.freq_hz.max():.4g} Hz; fitted by a stable "
+                  f"model of order {measured_fit.order} (relative residual {measured_fit.residual:.3g})",
+                  file=out, flush=True)
     kw = dict(excitation=excitation, measurement=measurement, control_input=control_input,
               control_output=control_output, Ww=Ww, regularization=regularization)
     probe = mbi_plant(true, engineering, Wz=1.0, **kw)
@@ -673,6 +740,15 @@ def identify(true, engineering, *, excitation: str, measurement: str, control_in
     best = min(ok, key=lambda i: tries[i].Wz) if ok else int(np.argmin([t.mu_upper for t in tries]))
     plant, res = runs[best]
     notes = start_notes
+    if measured_fit is not None:
+        Gm = np.asarray(measured.response, complex)
+        xc = freqresp(controlled_engineering(plant, res.K), 2 * np.pi * np.asarray(measured.freq_hz, float))[0, 0]
+        rel = float(np.sqrt(np.mean(np.abs(xc - Gm) ** 2 / np.abs(Gm) ** 2)))
+        notes.append(f"against the measured data themselves the controlled model is off by {rel:.3g} "
+                     f"(RMS relative; the fit of the data alone leaves {measured_fit.residual:.3g})")
+        notes.append(f"true system: the measured FRF fitted by a stable model of order {measured_fit.order} "
+                     f"(relative residual {measured_fit.residual:.3g})" +
+                     (f"; {measured_fit.notes[0]}" if measured_fit.notes else ""))
     if not 1.0 - tol <= tries[best].mu_upper <= 1.0:
         notes.append(f"W_z search stopped after {len(tries)} tries without mu in [{1 - tol:.3g}, 1]; "
                      f"returning the try with {'the smallest W_z at mu <= 1' if ok else 'the lowest mu (> 1)'}")
@@ -686,7 +762,8 @@ def identify(true, engineering, *, excitation: str, measurement: str, control_in
         band = np.ones_like(band)
     fit = fit_impedance(res.K, omega[band], weight=sens[band])
     return MBIResult(res.K, tries[best].Wz, tries[best].mu_upper, tries[best].mu_lower, tries, plant, fit,
-                     controlled_engineering(plant, res.K), res, time.perf_counter() - t0, omega, notes, floor)
+                     controlled_engineering(plant, res.K), res, time.perf_counter() - t0, omega, notes, floor,
+                     measured_fit)
 
 
 def impedance_response(coeffs: dict, omega) -> np.ndarray:
