@@ -4,49 +4,19 @@ The submissions ``tests/grading_submissions/ex02_*.py``, the reference
 solution and the stub are graded once, two at a time in the background; the
 diagnoses are also checked in-process on constructed answers.
 """
-import threading
-from concurrent.futures import ThreadPoolExecutor
-from pathlib import Path
 
 import numpy as np
 import pytest
 
+from grading_harness import ROOT, GradedSubmissions, full, q
 from mutext import cli
-from mutext.grading import grade
 from mutext.grading import ex02_mu as ex02
 from mutext.grading.solutions import ex02_mu as sol
 
-ROOT = Path(__file__).resolve().parents[1]
-SUBS = Path(__file__).resolve().parent / "grading_submissions"
 EXERCISE = "ex02_mu"
 SP = "M = [[2, 2], [-1, -1]] (Skogestad & Postlethwaite, example 8.5)"
-
-SUBMISSIONS = {
-    "reference": ROOT / "mutext" / "grading" / "solutions" / "ex02_mu.py",
-    "stub": ROOT / "exercises" / "ex02_mu.py",
-    **{p.stem: p for p in SUBS.glob("ex02_*.py")},
-}
-
-_pool = ThreadPoolExecutor(max_workers=2)
-_futures = {}
-_lock = threading.Lock()
-
-
-def graded(name):
-    """Report of a submission; the first call starts grading all of them in the background."""
-    with _lock:
-        if not _futures:
-            for n in sorted(SUBMISSIONS, key=lambda n: n != "reference"):
-                _futures[n] = _pool.submit(grade, EXERCISE, SUBMISSIONS[n], 60.0)
-    return _futures[name].result()
-
-
-def q(report, qid):
-    return next(x for x in report.questions if x.id == qid)
-
-
-def full(report, *qids):
-    return all(q(report, i).score == q(report, i).max_score for i in qids)
+graded = GradedSubmissions(EXERCISE)
+SUBMISSIONS = graded.paths
 
 
 # ----------------------------------------------------------------------------

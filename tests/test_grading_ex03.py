@@ -5,48 +5,19 @@ solution and the stub are graded once, two at a time in the background; the
 feedback of each diagnosis is also checked in-process on constructed answers.
 """
 import math
-import threading
-from concurrent.futures import ThreadPoolExecutor
-from pathlib import Path
 
 import numpy as np
 import pytest
 
+from grading_harness import ROOT, GradedSubmissions, full, q
 from mutext import cli
-from mutext.grading import grade
 from mutext.grading import ex03_free_decay as ex03
+from mutext.grading import grade
 from mutext.grading.solutions import ex03_free_decay as sol
 
-ROOT = Path(__file__).resolve().parents[1]
-SUBS = Path(__file__).resolve().parent / "grading_submissions"
 EXERCISE = "ex03_free_decay"
-
-SUBMISSIONS = {
-    "reference": ROOT / "mutext" / "grading" / "solutions" / "ex03_free_decay.py",
-    "stub": ROOT / "exercises" / "ex03_free_decay.py",
-    **{p.stem: p for p in SUBS.glob("ex03_*.py")},
-}
-
-_pool = ThreadPoolExecutor(max_workers=2)
-_futures = {}
-_lock = threading.Lock()
-
-
-def graded(name):
-    """Report of a submission; the first call starts grading all of them in the background."""
-    with _lock:
-        if not _futures:
-            for n in sorted(SUBMISSIONS, key=lambda n: n != "reference"):
-                _futures[n] = _pool.submit(grade, EXERCISE, SUBMISSIONS[n], 60.0)
-    return _futures[name].result()
-
-
-def q(report, qid):
-    return next(x for x in report.questions if x.id == qid)
-
-
-def full(report, *qids):
-    return all(q(report, i).score == q(report, i).max_score for i in qids)
+graded = GradedSubmissions(EXERCISE)
+SUBMISSIONS = graded.paths
 
 
 # ----------------------------------------------------------------------------

@@ -177,3 +177,31 @@ def response(sys_, w):
             return freqresp(sys_, w), None
     except Exception as exc:   # noqa: BLE001
         return None, f"the frequency response could not be evaluated ({exc})"
+
+
+def as_array(value, what: str):
+    """A returned array payload as a float ndarray, or ``(None, message)`` naming ``what``."""
+    try:
+        return np.asarray(value["data"], dtype=float).reshape(value["shape"]), None
+    except Exception as exc:   # noqa: BLE001 - malformed payload is the submission's fault
+        return None, f"{what}: the returned value is not an array of numbers ({exc})"
+
+
+def returned(outcomes, calls, feedback: list, parse=None, what: str = ""):
+    """The calls that returned a usable value, as ``(call, tag, value)``.
+
+    A call that raised, or whose value ``parse(value, what)`` rejects (it returns
+    ``(obj, error)``, e.g. :func:`as_array`, :func:`build_ss`), adds one line
+    ``"[label] message"`` to ``feedback`` and is skipped."""
+    for call, oc in zip(calls, outcomes):
+        tag = f"[{call.label}]"
+        if not oc["ok"]:
+            feedback.append(f"{tag} {oc['error']}")
+            continue
+        value = oc["value"]
+        if parse is not None:
+            value, err = parse(value, what)
+            if err:
+                feedback.append(f"{tag} {err}")
+                continue
+        yield call, tag, value

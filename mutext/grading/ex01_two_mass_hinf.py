@@ -22,7 +22,8 @@ import numpy as np
 
 from ..lti import hinf_norm as ref_hinf_norm
 from ..lti import lft_lower, mck_to_ss, ss
-from .compare import build_ss, compare_responses, fmt, matches, permutation_hint, resonance_safe_grid, response
+from .compare import (build_ss, compare_responses, fmt, matches, permutation_hint, resonance_safe_grid, response,
+                      returned)
 from .core import Call, Exercise, Question
 from .solutions import ex01_two_mass_hinf as sol
 
@@ -63,20 +64,11 @@ def _mech_alternatives(m1, m2, k1, k2):
 
 def _check_mechanical(outcomes, calls):
     ins, outs = ["f_e", "u"], ["x1", "x2"]
-    n_ok = n_all = 0
+    n_ok, n_all = 0, 4 * len(calls)
     fb = []
-    for call, oc in zip(calls, outcomes):
+    for call, tag, S in returned(outcomes, calls, fb, build_ss, "mechanical_model()"):
         p = dict(zip(MECH, call.args))
-        tag = f"[{call.label}]"
         ref = sol.mechanical_model(**p)
-        n_all += 4
-        if not oc["ok"]:
-            fb.append(f"{tag} {oc['error']}")
-            continue
-        S, err = build_ss(oc["value"], "mechanical_model()")
-        if err:
-            fb.append(f"{tag} {err}")
-            continue
         if (S.ninputs, S.noutputs) != (2, 2):
             fb.append(f"{tag} expected 2 inputs [f_e, u] and 2 outputs [x1, x2], got {S.ninputs} inputs "
                       f"and {S.noutputs} outputs")
@@ -150,20 +142,11 @@ def _plant_hints(p):
 
 
 def _check_plant(outcomes, calls):
-    n_ok = n_all = 0
+    n_ok, n_all = 0, 9 * len(calls)
     fb = []
-    for call, oc in zip(calls, outcomes):
+    for call, tag, S in returned(outcomes, calls, fb, build_ss, "generalized_plant()"):
         p = {**DEFAULTS, **call.kwargs}
-        tag = f"[{call.label}]"
         ref = sol.generalized_plant(**p)
-        n_all += 9
-        if not oc["ok"]:
-            fb.append(f"{tag} {oc['error']}")
-            continue
-        S, err = build_ss(oc["value"], "generalized_plant()")
-        if err:
-            fb.append(f"{tag} {err}")
-            continue
         if (S.ninputs, S.noutputs) != (3, 3):
             fb.append(f"{tag} expected 3 inputs [f1, f2, u] and 3 outputs [z1, z2, y], got {S.ninputs} "
                       f"inputs and {S.noutputs} outputs")

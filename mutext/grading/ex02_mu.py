@@ -43,7 +43,7 @@ import threading
 import numpy as np
 from scipy.optimize import minimize
 
-from .compare import fmt
+from .compare import as_array, fmt, returned
 from .core import Call, Exercise, Question
 
 POINTS = {"a1": 1.0, "a2": 2.0, "b": 2.0, "c": 3.0, "d": 2.0}
@@ -147,12 +147,6 @@ def prepare():
 # helpers
 # ----------------------------------------------------------------------------
 
-def _array(value, what):
-    try:
-        return np.asarray(value["data"], dtype=float).reshape(value["shape"]), None
-    except Exception as exc:   # noqa: BLE001 - malformed payload is the submission's fault
-        return None, f"{what}: the returned value is not an array of numbers ({exc})"
-
 
 def _close(x, ref, rtol=RTOL_MU):
     return bool(np.isfinite(x) and abs(x - ref) <= rtol * max(abs(ref), 1e-12))
@@ -228,12 +222,8 @@ def _check_a(outcomes, calls, which):
     qid = "a1" if which == "full" else "a2"
     per = POINTS[qid] / len(calls)
     score, fb, n_ok = 0.0, [], 0
-    for call, oc in zip(calls, outcomes):
-        tag = f"[{call.label}]"
-        if not oc["ok"]:
-            fb.append(f"{tag} {oc['error']}")
-            continue
-        x = float(oc["value"])
+    for call, tag, value in returned(outcomes, calls, fb):
+        x = float(value)
         M = MATRICES[call.label]
         if which == "full":
             ref, mistakes = float(_sv(M)[0]), _mistakes_full(M)
@@ -262,15 +252,7 @@ def _residual(M, Delta):
 def _check_b(outcomes, calls):
     per = POINTS["b"] / len(calls)
     score, fb, n_ok = 0.0, [], 0
-    for call, oc in zip(calls, outcomes):
-        tag = f"[{call.label}]"
-        if not oc["ok"]:
-            fb.append(f"{tag} {oc['error']}")
-            continue
-        X, err = _array(oc["value"], "destabilizing_delta()")
-        if err:
-            fb.append(f"{tag} {err}")
-            continue
+    for call, tag, X in returned(outcomes, calls, fb, as_array, "destabilizing_delta()"):
         M = MATRICES[call.label]
         n = M.shape[0]
         if X.shape == (2, n):
@@ -399,12 +381,8 @@ def _diagnose_lft(Ps, s, m, k, rel):
 def _check_c(outcomes, calls):
     per = POINTS["c"] / len(calls)
     score, fb, n_ok = 0.0, [], 0
-    for call, oc in zip(calls, outcomes):
-        tag = f"[{call.label}]"
-        if not oc["ok"]:
-            fb.append(f"{tag} {oc['error']}")
-            continue
-        v = oc["value"]
+    for call, tag, value in returned(outcomes, calls, fb):
+        v = value
         try:
             A, B, C, D = (np.atleast_2d(np.asarray(v[x], dtype=float)) for x in "ABCD")
         except Exception as exc:   # noqa: BLE001

@@ -34,7 +34,7 @@ import threading
 import numpy as np
 import scipy.linalg as sla
 
-from .compare import fmt
+from .compare import as_array, fmt, returned
 from .core import Call, Exercise, Question
 
 POINTS = {"a": 3.0, "b": 2.0, "c": 2.0, "d": 3.0}
@@ -161,13 +161,6 @@ def prepare():
 # helpers
 # ----------------------------------------------------------------------------
 
-def _array(value, what):
-    """The child's ``{"shape", "data"}`` as an ndarray, or ``(None, message)``."""
-    try:
-        return np.asarray(value["data"], dtype=float).reshape(value["shape"]), None
-    except Exception as exc:   # noqa: BLE001 - malformed payload is the submission's fault
-        return None, f"{what}: the returned value is not an array of numbers ({exc})"
-
 
 def close(X, Y, rtol=RTOL):
     """Same shape and ``max|X - Y| <= rtol max|Y|`` (False on NaN)."""
@@ -288,15 +281,7 @@ def _diagnose_element(X, Y, L, which, Mr=None):
 def _check_element(outcomes, calls):
     per = POINTS["a"] / (2 * len(calls))
     score, fb, n_ok = 0.0, [], 0
-    for call, oc in zip(calls, outcomes):
-        tag = f"[{call.label}]"
-        if not oc["ok"]:
-            fb.append(f"{tag} {oc['error']}")
-            continue
-        V, err = _array(oc["value"], "element_matrices()")
-        if err:
-            fb.append(f"{tag} {err}")
-            continue
+    for call, tag, V in returned(outcomes, calls, fb, as_array, "element_matrices()"):
         if V.shape != (2, 4, 4):
             fb.append(f"{tag} element_matrices() must return the pair (K, M) of 4x4 arrays, got an array of "
                       f"shape {V.shape}")
@@ -333,15 +318,7 @@ def _same_spectrum(Ks, Ms, K, M):
 def _check_assembly(outcomes, calls):
     per = POINTS["b"] / (2 * len(calls))
     score, fb, n_ok = 0.0, [], 0
-    for call, oc in zip(calls, outcomes):
-        tag = f"[{call.label}]"
-        if not oc["ok"]:
-            fb.append(f"{tag} {oc['error']}")
-            continue
-        V, err = _array(oc["value"], "assemble()")
-        if err:
-            fb.append(f"{tag} {err}")
-            continue
+    for call, tag, V in returned(outcomes, calls, fb, as_array, "assemble()"):
         n, length, E, I, rho, A, support = call.args
         d = call.kwargs_ref["d"]
         if V.ndim != 3 or V.shape[0] != 2 or V.shape[1] != V.shape[2]:
@@ -420,15 +397,7 @@ def _global_name(k):
 def _check_frequencies(outcomes, calls):
     per = POINTS["c"] / len(calls)
     score, fb, n_ok = 0.0, [], 0
-    for call, oc in zip(calls, outcomes):
-        tag = f"[{call.label}]"
-        if not oc["ok"]:
-            fb.append(f"{tag} {oc['error']}")
-            continue
-        w, err = _array(oc["value"], "natural_frequencies()")
-        if err:
-            fb.append(f"{tag} {err}")
-            continue
+    for call, tag, w in returned(outcomes, calls, fb, as_array, "natural_frequencies()"):
         n, length, E, I, rho, A, support, n_modes = call.args
         d = call.kwargs_ref["d"]
         ref = frequencies(*supported(n, length, E, d, rho, support), n_modes)
@@ -536,15 +505,7 @@ def _diagnose_errors(e, ref, length, E, d, rho, support, mode):
 def _check_errors(outcomes, calls):
     per = POINTS["d"] / len(calls)
     score, fb, n_ok = 0.0, [], 0
-    for call, oc in zip(calls, outcomes):
-        tag = f"[{call.label}]"
-        if not oc["ok"]:
-            fb.append(f"{tag} {oc['error']}")
-            continue
-        e, err = _array(oc["value"], "relative_errors()")
-        if err:
-            fb.append(f"{tag} {err}")
-            continue
+    for call, tag, e in returned(outcomes, calls, fb, as_array, "relative_errors()"):
         length, E, I, rho, A, support = call.args
         mode = call.kwargs["mode"]
         d = call.kwargs_ref["d"]
