@@ -41,7 +41,9 @@ loop has a pole at +0.0065 rad/s; mutext's is stable at 1.18, because its LMI
 K step fails to build a controller once the D scalings are fitted (the plant's
 performance weight has poles at -1e-6 rad/s, which makes the closed-loop
 Lyapunov matrix span about six decades) and the iteration falls back to
-constant scalings.
+constant scalings.  The error message says so; with the weight's poles moved
+to -1e-4 rad/s mutext reaches 1.0318 with 18 states in 33 s (the textbook's
+D-K iteration ends near 1.02).
 
 Usage::
 

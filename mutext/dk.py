@@ -54,6 +54,13 @@ certified bound at that frequency), with lower bounds at the peaks
 (:func:`mutext.mu.mu_sweep`) and, when the structure has real blocks, the
 D-G bound (:func:`mutext.mu.mu_upper`).
 
+Performance weights that approximate an integrator by a pole very close to the
+axis (e.g. at -1e-6 rad/s) combined with dynamic scalings of modes at tens of
+rad/s can defeat the LMI K step (the closed-loop Lyapunov matrix then spans
+more decades than the solver resolves); the iteration then keeps lower-order
+scalings and notes why, and the K-step error names those poles.  Moving them
+to about 1e-4 of the fastest mode avoids this.
+
 References
 ----------
 .. [ZDG] K. Zhou, J. C. Doyle and K. Glover, *Robust and Optimal Control*,

@@ -401,6 +401,25 @@ def riccati_feasible(p: PlantParts, g: float) -> bool:
     return float(np.max(np.abs(np.linalg.eigvals(X @ Y)))) < g * g
 
 
+def _near_axis_hint(P, ratio: float = 1e-6) -> str:
+    """A note for failure messages when the plant has stable poles so slow, against
+    its fastest ones, that an LMI solver cannot resolve them (typically an integrator
+    in a performance weight approximated by a pole at 1e-6)."""
+    A = np.asarray(P.A, float)
+    if A.size == 0:
+        return ""
+    lam = np.linalg.eigvals(A)
+    fast = float(np.abs(lam).max())
+    slow = lam[(lam.real < 0) & (np.abs(lam.real) < ratio * fast)]
+    if fast == 0 or slow.size == 0:
+        return ""
+    worst = float(np.abs(slow.real).min())
+    return (f" [the plant has {slow.size} stable pole(s) with real part down to {-worst:.3g} against modes up to "
+            f"{fast:.3g} rad/s (ratio {worst / fast:.1g}): the LMIs cannot resolve them in double precision; "
+            f"moving them to at least {ratio * 10 * fast:.2g} rad/s (e.g. a weight's integrator "
+            f"approximation) usually fixes this]")
+
+
 def _refine_level(p: PlantParts, g_lmi: float, rtol: float = 1e-10):
     """Bisection on :func:`riccati_feasible` around the LMI level.  Returns the
     refined level, or None if the test does not bracket the LMI level."""
@@ -697,7 +716,7 @@ def _level(parts: PlantParts, notes: list, solver: str, scale: bool, refine: boo
             work0, gscale = trial, c
             break
     if first is None:
-        raise SolverError("H-infinity optimal level: the LMI solver failed on the scaled plant "
+        raise SolverError(f"H-infinity optimal level: the LMI solver failed on the scaled plant{_near_axis_hint(parts)} "
                           f"(tried w, z scalings 1, 1e3, 1e6); last error: {errors[-1]}")
     g0, R, S, st1 = first
     # Later passes re-solve in the state coordinates that balance the previous
@@ -868,7 +887,7 @@ def hinfsyn(P, nmeas: int, ncon: int, *, solver: str = "CLARABEL", backoff: floa
             last[t["objective"]] = t.get("error") or f"closed loop unstable at backoff {t['backoff']:g}"
         raise SolverError("H-infinity synthesis: no stabilizing controller passed the check "
                           f"(optimal level gamma={gamma:.6g}; {len(tries)} attempts at backoffs "
-                          f"{schedule[0]:g}..{schedule[-1]:g}); last outcome per objective: "
+                          f"{schedule[0]:g}..{schedule[-1]:g}){_near_axis_hint(P)}; last outcome per objective: "
                           + "; ".join(f"{k}: {v}" for k, v in last.items()))
     K, CL, stable, maxre, value, wpk, sly, gpk, gK, b = best
     if value > gK * (1 + 1e-6):

@@ -3,7 +3,7 @@ import control as ct
 import numpy as np
 import pytest
 
-from mutext.errors import IllPosedError, ModelError
+from mutext.errors import IllPosedError, ModelError, SolverError
 from mutext.examples import random_plants, two_mass
 from mutext.hinf import hinfsyn, riccati_feasible, check_plant, slycot_hinf_norm, slycot_hinfsyn
 from mutext.lti import hinf_norm, is_stable, lft_lower, ss
@@ -169,3 +169,15 @@ def test_discrete_time_rejected():
     Pd = ct.ss(P.A, P.B, P.C, P.D, 0.01)
     with pytest.raises(ModelError, match="continuous"):
         hinfsyn(Pd, 1, 1)
+
+
+def test_near_axis_poles_are_named_when_synthesis_fails():
+    """A D-scaled distillation-column plant (Skogestad & Postlethwaite sec. 8.12.4) whose
+    performance weight approximates an integrator by poles at -1e-6 rad/s: the LMI
+    controller cannot be built, and the error says why and what to change."""
+    from pathlib import Path
+    data = np.load(Path(__file__).parent / "data" / "near_axis_plant.npz")
+    P = ss(data["A"], data["B"], data["C"], data["D"])
+    with pytest.raises(SolverError, match=r"2 stable pole\(s\) with real part down to -1e-06 .*"
+                                          r"moving them to at least"):
+        hinfsyn(P, 2, 2, backoff=0.1, max_backoff=0.1)
