@@ -418,7 +418,6 @@ def test_demo_rotor_json(capsys):
     assert 20 < nf["healthy"][0] < 225 and 20 < nf["healthy"][2] < 225
     assert nf["cracked"][0] < nf["healthy"][0]             # heavier disk
     assert "no crack element" in out["note"]
-    assert out["seconds"] < 60
 
 
 # ----------------------------------------------------------------------------- ROSS
