@@ -1,9 +1,10 @@
 """Benchmark: D-K iteration (mutext.dk.dk_iteration) against dkpy.
 
 mutext runs with its defaults (``mutext default``: K-step plant of at most
-``n + 12`` states) and with a larger scaling budget (``mutext big``: ``n + 20``
-states); both use its own LMI K step (slycot only as a verified fallback when
-the LMI controller fails).
+``n + 12`` states), with the budget of ``mutext demo two-mass-mu`` (``mutext
+demo``: ``n + 16``) and with ``n + 20`` states (``mutext big``); all use its
+own LMI K step (slycot only as a verified fallback when the LMI controller
+fails).
 
 Problems: the two-mass robust-performance problem of the thesis (sec. 2.3.2,
 +/- 2 % on m1, m2, k1, k2) at ``x_max`` = 0.035 m and 0.041 m, and the
@@ -83,7 +84,7 @@ def problem(name):
 def run_mutext(name, config):
     from mutext.dk import dk_iteration
     P, ny, nu, S, _, _, omega = problem(name)
-    opts = {} if config == "default" else {"max_states": P.nstates + 20}
+    opts = {"default": {}, "demo": {"max_states": P.nstates + 16}, "big": {"max_states": P.nstates + 20}}[config]
     t0 = time.perf_counter()
     res = dk_iteration(P, S, ny, nu, omega=omega, out=None, **opts)
     sec = time.perf_counter() - t0
@@ -150,15 +151,18 @@ def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("--timeout", type=float, default=600.0, help="seconds per synthesis (default 600)")
     ap.add_argument("--problems", nargs="+", default=["two-mass-0.035", "two-mass-0.041", "skogestad"])
+    ap.add_argument("--tools", nargs="+", help="a subset of the tools (e.g. 'mutext demo' 'dkpy auto')")
     args = ap.parse_args(argv)
     from mutext.lti import as_ss, lft_lower, ss
     from mutext.mu import default_grid, mu_sweep
     try:
         import dkpy  # noqa: F401
-        tools = ["mutext default", "mutext big", "dkpy auto", "dkpy fixed"]
+        tools = ["mutext default", "mutext demo", "mutext big", "dkpy auto", "dkpy fixed"]
     except ImportError:
-        tools = ["mutext default", "mutext big"]
+        tools = ["mutext default", "mutext demo", "mutext big"]
         print("note: dkpy is not installed (pip install dkpy); its columns are skipped", file=sys.stderr)
+    if args.tools:
+        tools = [t for t in tools if t in args.tools]
     rows = []
     for name in args.problems:
         if name == "skogestad" and "dkpy auto" not in tools:
