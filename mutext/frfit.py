@@ -54,7 +54,11 @@ class RationalFit:
     omega : numpy.ndarray
         Frequencies of the data [rad/s].
     poles : numpy.ndarray
+        The real poles and the upper member of each complex pair.
     notes : list of str
+    coefficients : numpy.ndarray
+        Real coefficients of the pole-residue basis (one per real pole, two per
+        pair: the real and imaginary parts of its residue).
     """
     system: ct.StateSpace
     order: int
@@ -62,12 +66,11 @@ class RationalFit:
     omega: np.ndarray = field(repr=False)
     poles: np.ndarray = field(repr=False)
     notes: list = field(default_factory=list)
+    coefficients: np.ndarray = field(default=None, repr=False)
 
     def response(self, omega) -> np.ndarray:
         """:math:`H(j\\omega)` of the fitted model."""
-        return _eval(self.poles, self._residues, np.asarray(omega, float))
-
-    _residues: np.ndarray = field(default=None, repr=False)
+        return _eval(self.poles, self.coefficients, np.asarray(omega, float))
 
 
 def _check_data(omega, response):
@@ -202,8 +205,7 @@ def fit_frf(omega, response, order: int, *, iterations: int = 30, tol: float = 1
     res = float(np.sqrt(np.mean(np.abs(H - G) ** 2 / np.abs(G) ** 2)))
     A, B, C = _realisation(poles, x)
     sys = ss(A, B, C, np.zeros((1, 1)))
-    fit = RationalFit(sys, A.shape[0], res, w, poles, [], x)
-    return fit
+    return RationalFit(sys, A.shape[0], res, w, poles, [], x)
 
 
 def fit_frf_auto(omega, response, *, max_order: int = 24, tol: float = 0.02, min_order: int = 2) -> RationalFit:

@@ -540,10 +540,16 @@ def wz_floor(true, *, excitation: str, measurement: str, Ww: float = 1.0, omega=
 
     def spread(w):
         R = np.array([freqresp(S, w)[o, i] for S in systems])        # (samples, nw)
-        dist = np.abs(R[:, None, :] - R[None, :, :])
-        k = int(np.argmax(dist.max(axis=(0, 1))))
-        a, b = np.unravel_index(np.argmax(dist[:, :, k]), dist.shape[:2])
-        return dist[a, b, k] / 2, w[k], (a, b)
+        # widest pair per frequency, one sample against all at a time (memory: samples x nw)
+        best, partner = np.zeros(w.size), np.zeros((2, w.size), dtype=int)
+        for a in range(len(systems)):
+            d = np.abs(R - R[a])
+            b = np.argmax(d, axis=0)
+            da = d[b, np.arange(w.size)]
+            better = da > best
+            best[better], partner[0, better], partner[1, better] = da[better], a, b[better]
+        k = int(np.argmax(best))
+        return best[k] / 2, w[k], (partner[0, k], partner[1, k])
 
     half, wk, pair = spread(omega)
     for _ in range(2):       # lightly damped resonances: zoom in around the widest spread
