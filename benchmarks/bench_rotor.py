@@ -37,18 +37,9 @@ import time
 
 import numpy as np
 
-FRISWELL_0 = [86.66, 86.66, 274.31, 274.31, 716.78, 716.78]
-FRISWELL_4000 = [85.39, 87.80, 251.78, 294.71, 600.18, 827.08]
-
-
-def friswell_rotor():
-    from mutext.rotor import BearingElement, DiskElement, Param, Rotor, ShaftElement
-    E, G, rho = 211e9, 81.2e9, 7810.0
-    mat = dict(E=Param("E", E, "Pa"), G=Param("G", G, "Pa"), rho=Param("rho", rho, "kg/m^3"))
-    els = [ShaftElement(i, 0.25, 0.05, 0.0, **mat) for i in range(1, 7)]
-    els += [DiskElement.from_geometry(3, 0.07, 0.28, 0.05, rho), DiskElement.from_geometry(5, 0.07, 0.35, 0.05, rho)]
-    els += [BearingElement(1, 1e6), BearingElement(7, 1e6)]
-    return Rotor(els, name="Friswell 5.9.1")
+from mutext.examples.friswell import FREQUENCIES_0_RPM as FRISWELL_0
+from mutext.examples.friswell import FREQUENCIES_4000_RPM as FRISWELL_4000
+from mutext.examples.friswell import rotor as friswell_rotor
 
 
 def median_time(fn, repeat):
