@@ -22,6 +22,11 @@ rig
     Virtual test rig and FRF files.
 sysid
     Parameters from free-decay records.
+diagnose
+    From measured FRFs to what a model gets wrong, its cause, the extended
+    model and the gain on held-out data (``mutext diagnose``).
+hide
+    Data sets with a hidden effect (``mutext rig hide``): exercises and tests.
 rotor
     Finite-element rotors, cracks, reduction and tuning (CasADi, IPOPT).
 examples

@@ -1,4 +1,4 @@
-"""Command-line interface: ``mutext demo ...`` and ``mutext grade ...``."""
+"""Command-line interface: ``mutext diagnose``, ``mutext rig``, ``mutext demo`` and ``mutext grade``."""
 from __future__ import annotations
 
 import argparse
@@ -59,6 +59,23 @@ def _cmd_demo(argv) -> int:
     return int(mod.run(sub.parse_args(rest)) or 0)
 
 
+# name -> (module, one-line description); modules expose add_arguments(parser) and run(args) -> int
+COMMANDS = {
+    "diagnose": ("mutext.commands.diagnose",
+                 "what a model gets wrong against measured FRFs, its cause, the extended model and the gain"),
+    "rig": ("mutext.commands.rig", "virtual rig: 'rig hide' writes a data set with a hidden effect"),
+}
+
+
+def _cmd_module(name, argv) -> int:
+    import importlib
+    mod_name, desc = COMMANDS[name]
+    mod = importlib.import_module(mod_name)
+    p = argparse.ArgumentParser(prog=f"mutext {name}", description=desc)
+    mod.add_arguments(p)
+    return int(mod.run(p.parse_args(argv)) or 0)
+
+
 def _cmd_grade(argv) -> int:
     from .grading import cli_grade
     return cli_grade(argv)
@@ -67,8 +84,11 @@ def _cmd_grade(argv) -> int:
 def main(argv=None) -> int:
     argv = sys.argv[1:] if argv is None else list(argv)
     if not argv or argv[0] in ("-h", "--help"):
-        print("usage: mutext {demo,grade} ...\n\n"
-              "  demo NAME [--json] [--plots DIR]   run a demonstration (mutext demo --list)\n"
+        print("usage: mutext {diagnose,rig,demo,grade} ...\n\n"
+              "  diagnose MODEL.toml DATA.csv [...] [--validate VAL.csv ...] [--out DIR] [--json]\n"
+              "                                     what the model gets wrong, why, and the gain once fixed\n"
+              "  rig hide --seed N --out DIR        a data set with a hidden effect to diagnose\n"
+              "  demo NAME [options]                run a demonstration (mutext demo --list)\n"
               "  grade EXERCISE SUBMISSION [--json] score a submission offline\n")
         return 0
     cmd, rest = argv[0], argv[1:]
@@ -77,6 +97,8 @@ def main(argv=None) -> int:
             return _cmd_demo(rest)
         if cmd == "grade":
             return _cmd_grade(rest)
+        if cmd in COMMANDS:
+            return _cmd_module(cmd, rest)
     except MutextError as exc:
         print(f"mutext {cmd}: error: {exc}", file=sys.stderr)
         return 1
@@ -85,7 +107,7 @@ def main(argv=None) -> int:
         import os
         os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
         return 0
-    print(f"mutext: unknown command '{cmd}' (expected 'demo' or 'grade')", file=sys.stderr)
+    print(f"mutext: unknown command '{cmd}' (expected one of diagnose, rig, demo, grade)", file=sys.stderr)
     return 2
 
 

@@ -13,7 +13,7 @@ import numpy as np
 from .lti import as_ss, freqresp, sigma_max
 
 __all__ = ["frequency_grid", "bode_mag", "bode_phase", "sigma_plot", "closed_loop_figure",
-           "controller_figure", "sigma_figure", "two_mass_hinf_figures", "mbi_figure"]
+           "controller_figure", "sigma_figure", "two_mass_hinf_figures", "mbi_figure", "diagnosis_figures"]
 
 
 def _plt():
@@ -323,3 +323,77 @@ def mbi_figure(result, true_systems, Du=None, title=None):
         fig.suptitle(title)
     fig.tight_layout()
     return fig
+
+
+def diagnosis_figures(result, outdir) -> list[str]:
+    """Figures of a :class:`mutext.diagnose.Diagnosis` saved as PNG in ``outdir``; returns the paths.
+
+    ``overlay.png``: magnitude and phase of data, engineering model and extended
+    model for each channel; ``residual.png``: the model/data log-magnitude
+    ratio over frequency before and after; ``ranking.png``: the improvement
+    of the fit (delta chi2) of the best hypotheses against the acceptance threshold.
+    """
+    plt = _plt()
+    os.makedirs(outdir, exist_ok=True)
+    paths = []
+    chans = result.channels
+    n = len(chans)
+    ncol = min(n, 3)
+    nrow = -(-n // ncol)
+    fig, axes = plt.subplots(2 * nrow, ncol, figsize=(4.4 * ncol, 4.6 * nrow), squeeze=False, sharex="col")
+    for k in range(n, nrow * ncol):
+        axes[2 * (k // ncol), k % ncol].set_visible(False)
+        axes[2 * (k // ncol) + 1, k % ncol].set_visible(False)
+    for k, c in enumerate(chans):
+        ax, axp = axes[2 * (k // ncol), k % ncol], axes[2 * (k // ncol) + 1, k % ncol]
+        ax.semilogy(c.freq_hz, np.abs(c.measured), ".", ms=2.5, color="0.3", label="measured")
+        ax.semilogy(c.freq_hz, np.abs(c.before), "-", color="C3", lw=1.2, label="model")
+        axp.plot(c.freq_hz, np.degrees(np.angle(c.measured)), ".", ms=2.5, color="0.3")
+        axp.plot(c.freq_hz, np.degrees(np.angle(c.before)), "-", color="C3", lw=1.2)
+        if c.after is not None:
+            ax.semilogy(c.freq_hz, np.abs(c.after), "--", color="C0", lw=1.2, label="extended model")
+            axp.plot(c.freq_hz, np.degrees(np.angle(c.after)), "--", color="C0", lw=1.2)
+        ax.set_title(f"{c.label} ({c.role})", fontsize=9)
+        axp.set_xlabel("frequency [Hz]")
+        if k == 0:
+            ax.set_ylabel("|H| [SI]")
+            axp.set_ylabel("phase [deg]")
+            ax.legend(fontsize=7)
+    fig.tight_layout()
+    p = os.path.join(outdir, "overlay.png")
+    fig.savefig(p, dpi=110)
+    plt.close(fig)
+    paths.append(p)
+
+    fig, ax = plt.subplots(figsize=(7, 3.6))
+    for k, c in enumerate(chans):
+        ax.plot(c.freq_hz, _db(c.before) - _db(c.measured), "-", color=f"C{k}", lw=1, label=f"{c.label} before")
+        if c.after is not None:
+            ax.plot(c.freq_hz, _db(c.after) - _db(c.measured), ":", color=f"C{k}", lw=1, label=f"{c.label} after")
+    noise_db = 20 * np.log10(1 + result.noise)
+    ax.axhspan(-2 * noise_db, 2 * noise_db, color="0.85", label="2 x noise")
+    ax.set_xlabel("frequency [Hz]")
+    ax.set_ylabel("model / measured [dB]")
+    ax.legend(fontsize=7, ncol=2)
+    fig.tight_layout()
+    p = os.path.join(outdir, "residual.png")
+    fig.savefig(p, dpi=110)
+    plt.close(fig)
+    paths.append(p)
+
+    top = [f for f in result.findings if f.kind != "none"][:10]
+    fig, ax = plt.subplots(figsize=(7, 0.35 * len(top) + 1.2))
+    labels = [f"{f.kind} @ {f.station} ({f.element})" for f in top][::-1]
+    vals = [max(f.delta_chi2, 1e-1) for f in top][::-1]
+    ax.barh(labels, vals, color=["C0" if f.significant else "0.6" for f in top][::-1])
+    ax.axvline(result.threshold, color="C3", lw=1, label=f"threshold {result.threshold:.1f}")
+    ax.set_xscale("log")
+    ax.set_xlabel("improvement of the fit, delta chi2")
+    ax.tick_params(axis="y", labelsize=7)
+    ax.legend(fontsize=7)
+    fig.tight_layout()
+    p = os.path.join(outdir, "ranking.png")
+    fig.savefig(p, dpi=110)
+    plt.close(fig)
+    paths.append(p)
+    return paths

@@ -260,9 +260,17 @@ def read_frf(path) -> FRF:
     """
     path = Path(path)
     try:
-        text = path.read_text(encoding="utf-8-sig")
+        raw = path.read_bytes()
     except OSError as exc:
         raise FRFFileError(path, None, None, f"cannot read file: {exc.strerror or exc}") from None
+    if b"\x00" in raw:
+        raise FRFFileError(path, None, None, "binary file (it contains NUL bytes); an FRF file is UTF-8 text")
+    try:
+        text = raw.decode("utf-8-sig")
+    except UnicodeDecodeError as exc:
+        line = raw[:exc.start].count(b"\n") + 1
+        raise FRFFileError(path, line, None, f"not UTF-8 text (byte 0x{raw[exc.start]:02x}); save the file "
+                                             f"as UTF-8") from None
     lines = text.splitlines()
     header: dict[str, tuple[str, int]] = {}
     i = 0

@@ -249,3 +249,30 @@ def test_full_sweep_three_parameters_and_monte_carlo_uncertainty(rotor):
     assert np.all(np.abs(est.mean(axis=0) / true - 1) < 0.01)
     ratio = est.std(axis=0, ddof=1) / std.mean(axis=0)
     assert np.all((ratio > 0.4) & (ratio < 2.0)), ratio      # 8 samples: a loose check
+
+
+def test_tune_with_force_inputs_recovers_a_lumped_spring():
+    """Force-input channels (a unit force at a DOF): the derivative of the input column is zero.
+
+    The data come from a plain numpy assembly of the chain (not from the model being tuned)."""
+    import tomllib
+    from importlib import resources
+    from mutext.hide import plain_chain
+    from mutext.rig import FRF
+    from mutext.rotor.model import load_model
+    path = resources.files("mutext") / "data" / "three_mass.toml"
+    with open(path, "rb") as fh:
+        doc = tomllib.load(fh)
+    M, C, K, forces, sensors, _ = plain_chain(doc)
+    K = K.copy()
+    K[2, 2] += 150.0                       # k3: 386 -> 536 N/m
+    f = np.linspace(0.3, 7.0, 200)
+    w = 2 * np.pi * f
+    frfs = []
+    for s in ("x1", "x3"):
+        H = np.array([np.linalg.solve(K - wk ** 2 * M + 1j * wk * C, np.eye(3)[:, forces["f1"]])[sensors[s]]
+                      for wk in w])
+        frfs.append(FRF(f, H, input_station=1, output_station=sensors[s] + 1))
+    res = tune(load_model(str(path)), frfs, ["k3"])
+    assert res.values["k3"] == pytest.approx(536.0, rel=1e-6)
+    assert res.iterations < 30

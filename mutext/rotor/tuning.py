@@ -202,13 +202,15 @@ class _Inputs:
             self.specs.append(spec)
         return self.specs.index(spec)
 
-    def matrix(self, B_full: np.ndarray) -> np.ndarray:
+    def matrix(self, B_full: np.ndarray, derivative: bool = False) -> np.ndarray:
+        """The used input columns from ``B_full`` (or, with ``derivative``, from its derivative
+        ``dB``: a unit force at a DOF does not depend on the parameters, so its column is zero)."""
         n = self.model.ndof
         out = np.zeros((n, len(self.specs)))
         for k, (kind, j) in enumerate(self.specs):
             if kind == "port":
                 out[:, k] = B_full[:, j]
-            else:
+            elif not derivative:
                 out[j, k] = 1.0
         return out
 
@@ -393,7 +395,7 @@ class _Evaluator:
                 Xf = X.reshape(self.model.ndof, nin * nf)
                 wcol = np.repeat(w[None, :], nin, axis=0).reshape(nin * nf)   # omega of each column
                 for j in range(npar):
-                    dBu = self.inputs.matrix(d["B"][j])
+                    dBu = self.inputs.matrix(d["B"][j], derivative=True)
                     dD = d["C"][j] + speed * d["G"][j]
                     dZX = d["K"][j] @ Xf - (wcol ** 2)[None, :] * (d["M"][j] @ Xf) \
                         + (1j * wcol)[None, :] * (dD @ Xf)

@@ -1,0 +1,35 @@
+"""A progress line on stderr for long library steps (the library reports through a callback)."""
+from __future__ import annotations
+
+import sys
+import time
+
+
+class ProgressLine:
+    """Callable ``(stage, fraction)``: one updating line on a terminal, a line per stage otherwise."""
+
+    def __init__(self, stream=None, enabled: bool = True):
+        self.stream = stream or sys.stderr
+        self.enabled = enabled
+        self.tty = hasattr(self.stream, "isatty") and self.stream.isatty()
+        self.t0 = time.perf_counter()
+        self.last = None
+
+    def __call__(self, stage: str, fraction: float):
+        if not self.enabled:
+            return
+        el = time.perf_counter() - self.t0
+        width = 24
+        bar = "#" * int(round(width * fraction)) + "-" * (width - int(round(width * fraction)))
+        line = f"[{bar}] {100 * fraction:3.0f} %  {el:5.1f} s  {stage}"
+        if self.tty:
+            self.stream.write("\r" + line[:110].ljust(110))
+            if fraction >= 1.0:
+                self.stream.write("\n")
+        else:
+            head = stage.split(" ")[0]
+            if head == self.last and fraction < 1.0:
+                return
+            self.last = head
+            self.stream.write(line + "\n")
+        self.stream.flush()

@@ -1,0 +1,108 @@
+"""Written results of a diagnosis: ``diagnosis.json``, an HTML report with its figures, the extended model.
+
+:func:`write_diagnosis` is what ``mutext diagnose --out DIR`` calls; the
+figures come from :func:`mutext.plots.diagnosis_figures`.
+"""
+from __future__ import annotations
+
+import html
+import json
+import os
+
+import numpy as np
+
+from .diagnose import Diagnosis, write_model
+from .plots import diagnosis_figures
+
+__all__ = ["write_diagnosis", "to_json"]
+
+
+def _conv(o):
+    if isinstance(o, np.ndarray):
+        return o.tolist()
+    if isinstance(o, (np.floating, np.integer, np.bool_)):
+        return o.item()
+    raise TypeError(f"not JSON serializable: {type(o).__name__}")
+
+
+def to_json(result: Diagnosis) -> str:
+    """The diagnosis as one JSON object (infinite numbers as strings ``"inf"``)."""
+    def clean(x):
+        if isinstance(x, float) and not np.isfinite(x):
+            return str(x)
+        if isinstance(x, dict):
+            return {k: clean(v) for k, v in x.items()}
+        if isinstance(x, list):
+            return [clean(v) for v in x]
+        return x
+    return json.dumps(clean(result.as_dict()), default=_conv)
+
+
+def write_diagnosis(result: Diagnosis, out_dir) -> dict:
+    """Write ``model_extended.toml`` (when there is a finding), ``diagnosis.json``, ``report.html``
+    and the figures into ``out_dir``; returns the paths written."""
+    os.makedirs(out_dir, exist_ok=True)
+    paths = {}
+    model = write_model(result, out_dir)
+    if model:
+        paths["extended_model"] = model
+    figs = diagnosis_figures(result, out_dir)
+    paths["figures"] = figs
+    jpath = os.path.join(out_dir, "diagnosis.json")
+    with open(jpath, "w", encoding="utf-8") as fh:
+        fh.write(to_json(result))
+    paths["json"] = jpath
+    hpath = os.path.join(out_dir, "report.html")
+    with open(hpath, "w", encoding="utf-8") as fh:
+        fh.write(_html(result, [os.path.basename(p) for p in figs]))
+    paths["report"] = hpath
+    return paths
+
+
+def _html(r: Diagnosis, figs) -> str:
+    e = html.escape
+    rows = "".join(
+        f"<tr><td>{k}</td><td>{e(f.kind)}</td><td>{f.station or '-'}</td><td>{e(str(f.element or '-'))}</td>"
+        f"<td>{'' if f.kind == 'none' else f'{f.value:.5g} {e(f.unit)}'}</td>"
+        f"<td>{'' if f.kind == 'none' else f'{f.std:.2g}'}</td><td>{f.delta_chi2:.1f}</td>"
+        f"<td>{'yes' if f.significant else ''}</td></tr>"
+        for k, f in enumerate(r.findings[:15], start=1))
+    res = "".join(
+        f"<tr><td>{e(x.channel)}</td><td>{x.measured_hz:.5g} &plusmn; {x.measured_hz_std:.2g}</td>"
+        f"<td>{x.model_hz:.5g}</td><td>{100 * x.freq_error:+.2f} %</td>"
+        f"<td>{x.measured_damping:.3g} &plusmn; {x.measured_damping_std:.2g}</td><td>{x.model_damping:.3g}</td></tr>"
+        for x in r.resonances)
+    amb = ""
+    if r.ambiguous_with:
+        amb = ("<p>Cannot be told apart with the channels measured: "
+               + "; ".join(e(f"{f.kind} at {f.station} ({f.element})") for f in r.ambiguous_with)
+               + (f". A sensor at station {r.separating_sensor} would separate them best." if r.separating_sensor
+                  else ".") + "</p>")
+    notes = "".join(f"<li>{e(n)}</li>" for n in r.notes)
+    imgs = "".join(f'<p><img src="{e(f)}" style="max-width:100%"></p>' for f in figs)
+    summary = "".join(f"<li>{e(s)}</li>" for s in r.summary)
+    return f"""<!DOCTYPE html>
+<html><head><meta charset="utf-8"><title>mutext diagnose: {e(r.model_name)}</title>
+<style>body{{font-family:sans-serif;max-width:60em;margin:auto}} td,th{{padding:2px 8px;text-align:right}}
+table{{border-collapse:collapse}} tr:nth-child(even){{background:#f3f3f3}}</style></head><body>
+<h1>Diagnosis of {e(r.model_name)}</h1>
+<p>Model file: <code>{e(str(r.model_source))}</code>. Noise level estimated from the data:
+{100 * r.noise:.3g} % (relative).</p>
+<h2>Verdict</h2><p><b>{e(r.verdict.sentence())}</b></p>{amb}
+<h2>What the model gets wrong</h2><ul>{summary}</ul>
+<table><tr><th>channel</th><th>measured Hz</th><th>model Hz</th><th>error</th><th>damping measured</th>
+<th>damping model</th></tr>{res}</table>
+<h2>Hypotheses ({r.n_hypotheses} tested; accepted when delta chi2 &gt; {r.threshold:.1f},
+false-alarm rate {100 * r.alpha:g} %)</h2>
+<table><tr><th>rank</th><th>kind</th><th>station</th><th>element</th><th>size</th><th>std</th>
+<th>delta chi2</th><th>significant</th></tr>{rows}</table>
+<h2>Gain on held-out data</h2><p>{e(r.held_out)}</p>
+<table><tr><th></th><th>rms complex error</th><th>rms log-magnitude error</th></tr>
+<tr><td>engineering model</td><td>{100 * r.error_before['rel']:.3g} %</td><td>{r.error_before['db']:.3g} dB</td></tr>
+<tr><td>extended model</td><td>{100 * r.error_after['rel']:.3g} %</td><td>{r.error_after['db']:.3g} dB</td></tr>
+</table><p>Gain: {r.gain:.3g}x.</p>
+{f'<p>Extended model: <code>{e(r.extended_model)}</code></p>' if r.extended_model else ''}
+<h2>Figures</h2>{imgs}
+{f'<h2>Notes</h2><ul>{notes}</ul>' if notes else ''}
+<p><small>{r.seconds:.1f} s</small></p></body></html>
+"""
