@@ -9,6 +9,8 @@ from .errors import MutextError
 
 # name -> (module, one-line description); modules expose add_arguments(parser) and run(args) -> int
 DEMOS = {
+    "diagnose": ("mutext.demos.diagnose",
+                 "a model, data with a hidden effect, and the diagnosis: what is wrong, why, the gain once fixed"),
     "two-mass-hinf": ("mutext.demos.two_mass_hinf",
                       "two-mass H-infinity control (thesis sec. 2.3.1): gamma by LMI vs slycot, checked controller"),
     "two-mass-mu": ("mutext.demos.two_mass_mu",
@@ -39,10 +41,13 @@ def _available_demos():
 
 def _cmd_demo(argv) -> int:
     demos = _available_demos()
-    p = argparse.ArgumentParser(prog="mutext demo", description="Run a demonstration.")
+    # no automatic --help here: 'mutext demo NAME --help' is the demo's own help
+    p = argparse.ArgumentParser(prog="mutext demo", description="Run a demonstration.", add_help=False)
     p.add_argument("name", nargs="?", help="demo to run (see --list)")
     p.add_argument("--list", action="store_true", help="list the demos and exit")
     args, rest = p.parse_known_args(argv)
+    if args.name is None and any(a in ("-h", "--help") for a in rest):
+        args.list = True
     if args.list or args.name is None:
         width = max(len(n) for n in demos)
         for n, d in demos.items():

@@ -775,10 +775,17 @@ class Diagnosis:
         out = [f"model: {self.model_source or self.model_name}",
                f"noise level estimated from the data: {100 * self.noise:.3g} % (relative, rms)", ""]
         if self.resonances:
-            out.append("resonances (measured from the data by vector fitting, +/- 1 std):")
+            # one row per model resonance: the channel that measures it most precisely
+            best: dict = {}
+            for r in self.resonances:
+                k = round(r.model_hz, 9)
+                if k not in best or r.measured_hz_std < best[k].measured_hz_std:
+                    best[k] = r
+            out.append("resonances (measured from the data by vector fitting, +/- 1 std; the most precise "
+                       "channel of each):")
             out.append(f"  {'channel':<10} {'measured Hz':>18} {'model Hz':>10} {'error':>8} "
                        f"{'zeta meas.':>16} {'zeta model':>10}")
-            for r in self.resonances:
+            for _, r in sorted(best.items()):
                 out.append(f"  {r.channel:<10} {r.measured_hz:>10.4g} +/-{r.measured_hz_std:<6.2g}"
                            f"{r.model_hz:>10.4g} {100 * r.freq_error:>+7.2f}% "
                            f"{r.measured_damping:>8.3g} +/-{r.measured_damping_std:<5.2g}{r.model_damping:>10.3g}")
@@ -806,7 +813,13 @@ class Diagnosis:
         out.append(f"  after:  {100 * ea['rel']:.3g} % rms complex error, {ea['db']:.3g} dB rms log-magnitude")
         out.append(f"  gain:   {self.gain:.3g}x  (noise level {100 * self.noise:.3g} %)")
         if self.mbi:
-            out.append(f"model-based identification at {self.mbi.get('location')}: {self.mbi.get('reading')}")
+            m = self.mbi
+            out.append(f"model-based identification (controller at {m.get('location')}): {m.get('reading')}")
+            if m.get("agrees") is not None:
+                out.append(f"  {m['compared']}: MBI {m['mbi_value']:+.4g} +/- {m['mbi_std']:.2g} against the "
+                           f"diagnosis {m['diagnosis_value']:+.4g}: "
+                           + ("they agree" if m["agrees"] else "they DISAGREE (beyond 3 standard uncertainties)")
+                           + f" (mu {m['mu']:.3f}, {m['seconds']:.0f} s)")
         if self.extended_model:
             out.append(f"extended model: {self.extended_model}")
         for n in self.notes:
@@ -947,6 +960,8 @@ def _summary(rows: list[ResonanceRow], chans, before) -> list[str]:
     out = []
     by_mode: dict[float, list] = {}
     for r in rows:
+        if not math.isfinite(r.measured_hz_std):     # not found in most bootstrap refits: not reliable
+            continue
         by_mode.setdefault(round(r.model_hz, 6), []).append(r)
     for k, (fmod, rs) in enumerate(sorted(by_mode.items()), start=1):
         r = min(rs, key=lambda x: x.measured_hz_std)
@@ -986,7 +1001,8 @@ def _same_data(a: FRF, b: FRF) -> bool:
 
 
 def diagnose(model, frfs, validate=None, *, alpha: float = 0.01, refit: int = 3, noise: float | None = None,
-             out_dir=None, progress: Callable[[str, float], None] | None = None) -> Diagnosis:
+             out_dir=None, progress: Callable[[str, float], None] | None = None,
+             only: Callable[[Hypothesis], bool] | None = None, mbi: bool = False) -> Diagnosis:
     r"""Find what ``model`` gets wrong against measured FRFs, name the cause, extend the model, measure the gain.
 
     See the module docstring for the method and the statistics.
@@ -1015,6 +1031,15 @@ def diagnose(model, frfs, validate=None, *, alpha: float = 0.01, refit: int = 3,
         Write ``model_extended.toml`` there (see also :func:`write_outputs`).
     progress : callable(stage: str, fraction: float), optional
         Called as the work proceeds (the command line draws a progress line).
+    mbi : bool
+        Also read the top finding the thesis's way (lumped chains): model-based
+        identification (:func:`mutext.mbi.identify`, D-K iteration) with the
+        controller at the finding's mass, K read as mass, damper and spring,
+        compared with the diagnosis (``Diagnosis.mbi``).  Takes 5-60 s more.
+    only : callable(Hypothesis) -> bool, optional
+        Test only the hypotheses it accepts (e.g. a fit told the kind and the
+        location: ``only=lambda h: (h.kind, h.station) == ("mass", 3)``); the
+        Bonferroni threshold counts the hypotheses actually tested.
 
     Returns
     -------
@@ -1112,6 +1137,10 @@ def diagnose(model, frfs, validate=None, *, alpha: float = 0.01, refit: int = 3,
 
     # 2. hypotheses
     hyps = hypotheses(eng) + _gain_hypotheses(eng, chans)
+    if only is not None:
+        hyps = [h for h in hyps if only(h)]
+        if not hyps:
+            raise ModelError("diagnose: no hypothesis passes the 'only' filter")
     N = 2 * fit.n_points
     rss0 = _rss(fit.H0, fit.meas)
     nh = len(hyps)
@@ -1196,10 +1225,67 @@ def diagnose(model, frfs, validate=None, *, alpha: float = 0.01, refit: int = 3,
     result = Diagnosis(eng.name, path, noise, findings, verdict, ambiguous, sensor, err_before, err_after, gain,
                        held_desc, comps, rows, summary, threshold, alpha, nh, text,
                        time.perf_counter() - t0, notes)
+    if mbi and verdict is not none:
+        tell("model-based identification at the finding (D-K iteration)", 0.97)
+        try:
+            result.mbi = mbi_reading(model_text, path, verdict, chans[0].frf, chans[0].in_name,
+                                     chans[0].out_name)
+        except ModelError as exc:
+            result.mbi = {"location": None, "reading": f"not run: {exc}", "agrees": None}
+        result.seconds = time.perf_counter() - t0
     if out_dir is not None:
         write_model(result, out_dir)
     tell("done", 1.0)
     return result
+
+
+def mbi_reading(model_text: str, path: str, finding: Finding, frf: FRF, excitation: str,
+                measurement: str) -> dict:
+    r"""The thesis's route to the same finding: a mu-controller at the finding's mass absorbs the effect.
+
+    The engineering model gets a force input and a displacement output at the
+    finding's mass; :func:`mutext.mbi.identify` tunes a controller there so that
+    the model follows the measured channel ``frf`` (``excitation`` to
+    ``measurement``), and reads it as an added mass, damper and spring
+    (:func:`mutext.mbi.fit_impedance`).  The quantity of the finding's kind is
+    compared with the diagnosis: they agree when they differ by at most three
+    combined standard uncertainties (the MBI one from its impedance fit:
+    the larger of the coefficient's standard error and the fit's relative
+    residual times the coefficient).
+
+    Only lumped chains and findings at one mass (a mass, a grounded spring or
+    damper) have a single controller location; other findings raise ModelError.
+    """
+    import tomllib
+    from .mbi import identify
+    from .rotor.model import loads_model
+    h = finding.hypothesis
+    doc = tomllib.loads(model_text)
+    if "mass" not in doc:
+        raise ModelError("model-based identification is run on lumped chains only (a rotor needs a reduced "
+                         "model and minutes of D-K iteration)")
+    if h is None or h.gain is not None or len(h.dofs) != 1:
+        raise ModelError(f"a {finding.kind} finding between two masses or on a gain has no single controller "
+                         "location")
+    mass = doc["mass"][h.station - 1]["name"]
+    text = model_text + (f'\n[[force]]\nname = "u_mbi"\nmass = "{mass}"\n'
+                         f'[[sensor]]\nname = "y_mbi"\nmass = "{mass}"\n')
+    ext = loads_model(text, source=f"{path} (controller at {mass})",
+                      base_dir=os.path.dirname(os.path.abspath(path)))
+    E = ext.state_space(inputs=[excitation, "u_mbi"], outputs=[measurement, "y_mbi"])
+    t0 = time.perf_counter()
+    res = identify(frf, E, excitation=excitation, measurement=measurement, control_input="u_mbi",
+                   control_output="y_mbi", out=None)
+    fit = res.fit
+    coef = {"mass": ("dm", 0), "damping": ("dc", 1), "stiffness": ("dk", 2)}[finding.kind]
+    v = float(getattr(fit, coef[0]))
+    sd = max(float(fit.sigma[coef[1]]), float(fit.residual) * abs(v))
+    comb = math.sqrt(sd ** 2 + finding.std ** 2)
+    return {"location": mass, "reading": fit.description, "mu": float(res.mu_upper), "Wz": float(res.Wz),
+            "dm": float(fit.dm), "dc": float(fit.dc), "dk": float(fit.dk),
+            "sigma": [float(x) for x in fit.sigma], "residual": float(fit.residual),
+            "compared": coef[0], "mbi_value": v, "mbi_std": sd, "diagnosis_value": finding.value,
+            "agrees": bool(abs(v - finding.value) <= 3 * comb), "seconds": time.perf_counter() - t0}
 
 
 def _finding(h, theta, std, rss, rss0, s2, N, threshold) -> Finding:

@@ -273,3 +273,15 @@ def test_docstring_examples_run():
     for mod in (mutext.diagnose, mutext.hide):
         res = doctest.testmod(mod, optionflags=doctest.ELLIPSIS)
         assert res.failed == 0 and res.attempted > 0
+
+
+def test_model_based_identification_reads_the_finding_the_same_way():
+    """The thesis's route: a mu-controller at the found mass, read as mass/damper/spring, agrees."""
+    case = hidden_effect_data("three_mass", seed=5, kind="stiffness", noise=0.01)
+    d = diagnose(case.model, case.measured, validate=case.validate, mbi=True)
+    assert (d.verdict.kind, d.verdict.station) == (case.key["kind"], case.key["station"])
+    m = d.mbi
+    assert m["compared"] == "dk" and m["agrees"], d.report()
+    assert m["mbi_value"] == pytest.approx(case.key["value"], rel=0.02)
+    assert m["mu"] <= 1.0
+    assert "model-based identification" in d.report()

@@ -16,6 +16,9 @@ def add_arguments(p):
     p.add_argument("--alpha", type=float, default=0.01, help="false-alarm rate of the 'none' verdict (default 0.01)")
     p.add_argument("--noise", type=float, default=None,
                    help="relative noise level of the data (default: estimated from the data)")
+    p.add_argument("--mbi", action="store_true",
+                   help="also read the top finding by model-based identification (lumped chains; D-K iteration, "
+                        "5-60 s more)")
     p.add_argument("--quiet", action="store_true", help="no progress output")
 
 
@@ -25,7 +28,7 @@ def run(args) -> int:
     from .progress import ProgressLine
     prog = ProgressLine(enabled=not args.quiet)
     res = diagnose(args.model, args.data, validate=args.validate or None, alpha=args.alpha, noise=args.noise,
-                   progress=prog)
+                   progress=prog, mbi=args.mbi)
     if args.out:
         prog("writing the report", 1.0)
         write_diagnosis(res, args.out)
