@@ -89,8 +89,8 @@ def main(argv=None):
     print(f"mutext diagnose on hidden effects ({len(jobs)} cases, {args.jobs} processes, "
           f"{time.perf_counter() - t0:.0f} s wall)")
     print()
-    print(f"| example | noise | cases | right (kind, place) | false alarms on 'none' | median size error "
-          f"| told kind+place | ratio | within 4 std | s median | s max |")
+    print("| example | noise | cases | right (kind, place) | false alarms on 'none' | median size error "
+          "| told kind+place | ratio | within 4 std | s median | s max |")
     print("|---|---|---|---|---|---|---|---|---|---|---|")
     for e in args.examples:
         for n in args.noise:

@@ -126,7 +126,7 @@ import os
 import re
 import time
 from dataclasses import dataclass, field
-from typing import Callable, Sequence
+from typing import Callable
 
 import numpy as np
 import scipy.stats as sst
@@ -298,10 +298,8 @@ def _rotor_hypotheses(model, stations=None) -> list[Hypothesis]:
 
 def _gain_hypotheses(model, channels) -> list[Hypothesis]:
     out = []
-    lay = model.layout
     seen_out, seen_in = set(), set()
     for ch in channels:
-        st = lay.dof_names[ch.out_dof]
         if ch.out_dof not in seen_out:
             seen_out.add(ch.out_dof)
             out.append(Hypothesis("sensor_gain", ch.out_station, ch.out_name, f"gain of sensor {ch.out_name}",
@@ -311,7 +309,6 @@ def _gain_hypotheses(model, channels) -> list[Hypothesis]:
             what = "exciter" if ch.in_spec[0] == "port" else "force input"
             out.append(Hypothesis("exciter_gain", ch.in_station, ch.in_name, f"gain of {what} {ch.in_name}",
                                   "1", False, 0.2, 5.0, 1.0, gain=("exciter", ch.in_spec), nominal=1.0))
-        del st
     return out
 
 
@@ -1093,6 +1090,8 @@ def diagnose(model, frfs, validate=None, *, alpha: float = 0.01, refit: int = 3,
         lv = [noise_level(c.frf.freq_hz, c.frf.response) for c in chans]
         npts = [c.frf.freq_hz.size for c in chans]
         noise = float(math.sqrt(np.average(np.square(lv), weights=npts)))
+    elif not (isinstance(noise, (int, float)) and math.isfinite(noise) and 0 < noise < 1):
+        raise ModelError(f"diagnose: noise must be a relative level in (0, 1), e.g. 0.01 for 1 %; got {noise!r}")
     noise = max(float(noise), 1e-6)
     s2 = noise ** 2 / 2.0
     tell("engineering model's receptance", 0.02)

@@ -46,6 +46,7 @@ from __future__ import annotations
 import json
 import math
 import os
+import re
 import shutil
 import tomllib
 from dataclasses import dataclass, field
@@ -55,7 +56,7 @@ from pathlib import Path
 import numpy as np
 
 from .errors import ModelError
-from .rig import FRF, Noise, measure, write_frf
+from .rig import Noise, measure, write_frf
 
 __all__ = ["hidden_effect_data", "HiddenCase", "EXAMPLES", "DETECTABLE", "plain_chain", "example_path"]
 
@@ -305,6 +306,15 @@ class _NotDetectable(Exception):
 # the rotor: the effect written into the model file
 # ----------------------------------------------------------------------------
 
+def _set_bearing_stiffness(text: str, station: int, value: float) -> str:
+    """Model-file text with the stiffness of the ``[[bearing]]`` at ``station`` set to ``value``."""
+    blocks = re.split(r"(?m)^(?=\s*\[)", text)
+    for k, b in enumerate(blocks):
+        if b.strip().startswith("[[bearing]]") and re.search(rf"(?m)^\s*station\s*=\s*{station}\b", b):
+            blocks[k] = re.sub(r"(?m)^(\s*stiffness\s*=\s*)[^#\n]*", rf"\g<1>{value!r} ", b, count=1)
+            return "".join(blocks)
+    raise ModelError(f"no [[bearing]] at station {station} in the model file")
+
 def _case_rotor(path, seed, kind, noise, rng):
     from .rotor.analysis import frf as model_frf
     from .rotor.elements import BearingElement
@@ -371,22 +381,9 @@ def _case_rotor(path, seed, kind, noise, rng):
             size = -kb * math.exp(rng.uniform(math.log(0.1), math.log(0.7)))
             key = {"kind": kind, "station": s, "element": el.name, "unit": "N/m",
                    "description": f"stiffness of {el.name} changed"}
-            import re
-
             def make(v, s=s, kb=kb):
-                lines, out, cur = text.splitlines(), [], None
-                for ln in lines:
-                    if ln.strip().startswith("["):
-                        cur = ln.strip()
-                        seen = False
-                    if cur == "[[bearing]]" and re.match(rf"^\s*station\s*=\s*{s}\b", ln):
-                        out.append(ln)
-                        out.append("__MARK__")
-                        continue
-                    out.append(ln)
-                t = "\n".join(out)
-                t = re.sub(r"__MARK__\n(\s*)stiffness\s*=\s*[^\n#]*", rf"\1stiffness = {kb + v!r}", t)
-                return loads_model(t, source=f"{path} (hidden effect)", base_dir=base_dir)
+                return loads_model(_set_bearing_stiffness(text, s, kb + v), source=f"{path} (hidden effect)",
+                                   base_dir=base_dir)
             limit = (-0.95 * kb, 10 * kb)
             null = 0.0
         elif kind == "crack":

@@ -70,7 +70,7 @@ def run(args) -> int:
         print("found: nothing beyond the noise, rightly")
     else:
         print(f"not found: the verdict is {v.kind} at {v.station}" +
-              (f"; the answer is among the hypotheses it cannot tell apart" if any(
+              ("; the answer is among the hypotheses it cannot tell apart" if any(
                   (a.kind, a.station) == (key["kind"], key["station"]) for a in d.ambiguous_with) else ""))
     if paths:
         print(f"report: {paths['report']}")
