@@ -290,3 +290,10 @@ def test_cli_misuse_exit_codes(capsys, tmp_path):
 def test_cli_list_through_main_dispatch(capsys):
     assert cli.main(["grade", "--list"]) == 0
     assert EXERCISE in capsys.readouterr().out
+
+
+def test_fmt_shows_nan_and_inf_as_real_numbers():
+    from mutext.grading.compare import fmt
+    assert fmt(float("nan")) == "nan" and fmt(np.nan) == "nan"
+    assert fmt(float("inf")) == "inf" and fmt(-np.inf) == "-inf"
+    assert fmt(2.0) == "2" and fmt(1 + 2j) == "1+2j" and fmt(0.0) == "0"

@@ -185,3 +185,31 @@ def test_cli_list_shows_ex03(capsys):
     assert cli.main(["grade", "--list"]) == 0
     out = capsys.readouterr().out
     assert EXERCISE in out and "ex04_beam_element" in out
+
+
+def test_nan_answers_are_named_not_a_crash(questions):
+    """Issue 21: NaN in (d) used to end in "could not be checked (ValueError: cannot convert float NaN ...)"."""
+    nan = float("nan")
+    score, fb = _check(questions, "d", lambda *a: [nan, nan, nan])
+    assert score == 0
+    assert not any("could not be checked" in line for line in fb)
+    assert sum("the answer is NaN" in line for line in fb) == 6
+    score, fb = _check(questions, "c", lambda *a: nan)
+    assert score == 0 and all("got nan; the answer is NaN" in line for line in fb)
+    assert not any("nan+0j" in line for line in fb)
+
+
+def test_junk_values_get_no_factor_2_hint(questions):
+    """Issue 21: a placeholder 1 is not "a factor 2" (ratios 0.51-0.52 of the references)."""
+    for qid in questions:
+        kind = questions[qid].kind
+        score, fb = _check(questions, qid, lambda *a: [1.0, 1.0, 1.0] if kind == "array" else 1.0)
+        assert not any("factor 2" in line for line in fb), (qid, fb)
+
+
+def test_factor_2_hint_only_near_2():
+    assert any("a factor 2" in h for h in ex03._ratio_hints(0.5, "c"))
+    assert any("a factor 2" in h for h in ex03._ratio_hints(2.004, "c"))
+    assert ex03._ratio_hints(0.5182, "c") == []
+    assert ex03._ratio_hints(0.5122, "c", tol=1e-4) == []
+    assert ex03._ratio_hints(float("nan"), "c") == []

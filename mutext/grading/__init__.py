@@ -9,37 +9,52 @@ no containers.
 How a submission is run
 -----------------------
 The submission is copied to a private temporary directory and imported in a
-child process (:mod:`mutext.grading.sandbox`, :mod:`mutext.grading._runner`)
-that only calls the student's functions on given inputs and sends back
-plain matrices and numbers.  All scores are computed in the grading process
-from those numbers: models are compared through their frequency responses,
-a controller is closed around the reference plant here.  The importing and
-each question have a wall-clock time limit; a question that hangs or
-crashes scores 0 and the remaining questions run in a fresh child.
+child process (:mod:`mutext.grading.sandbox`, :mod:`mutext.grading._jail`,
+:mod:`mutext.grading._runner`) that only calls the student's functions on
+given inputs and sends back plain matrices and numbers (JSON, validated on
+arrival).  The child holds no reference answers and no solution code; all
+scores are computed in the grading process from those numbers: models are
+compared through their frequency responses, a controller is closed around
+the reference plant here.  The importing and each question have a
+wall-clock time limit; a question that hangs or crashes scores 0 and the
+remaining questions run in a fresh child.
 
-Integrity
+Isolation
 ---------
-Before the submission is imported, the child installs an audit hook that
-blocks opening files of :mod:`mutext.grading` (with the reference
-solutions), :mod:`mutext.examples` and :mod:`mutext.demos` (and, in a source
-checkout, of ``.git`` and ``tests``; for an exercise whose answer the library
-computes, also that library module, e.g. :mod:`mutext.rotor` for ex04),
-importing those packages, writing into
-the installed package, starting processes and loading native code with
-:mod:`ctypes`.
-Students may use numpy, scipy, control, :mod:`mutext.lti` and
-:mod:`mutext.hinf`.  A blocked attempt inside a question's function scores
-that question 0; one at import time (module level) scores every question 0.
-The hook keeps honest students honest and catches casual copying; it is not
-a security boundary against deliberate attacks (run the grader in a
-container for that).
+The rules are enforced by the kernel, outside the student's interpreter:
+
+* as root (a Gradescope or CI container), the child runs as the user
+  ``nobody`` in its own mount and network namespaces, where the package,
+  the source checkout, ``/root``, ``/home`` and the temporary directories
+  are empty except for the Python installation and the child's own
+  directory (``isolation: uid`` in the report);
+* for everyone, where the kernel offers them, Landlock (read only Python,
+  the system and the child's own files; write only its directory; no TCP)
+  and a seccomp filter (no new processes); a plain user gets
+  ``isolation: landlock``;
+* resource limits: memory (address space), CPU time, file size, processes.
+
+The child checks from the inside that it cannot read the solutions nor
+write into site-packages; if it can, or nothing could be applied (macOS,
+an old kernel), the report says ``isolation: none``.  Grade a course as root
+in a container (``docs/grading.md``).
+
+Before the submission is imported the child also installs an audit hook
+that reports the usual attempts (importing ``mutext.grading``,
+``mutext.examples``, ``mutext.demos`` or an exercise's blocked module such
+as :mod:`mutext.rotor` for ex04, opening their files, starting processes,
+loading native code with :mod:`ctypes`) as integrity violations: one inside
+a question's function scores that question 0, one at import time every
+question.  Students may use numpy, scipy, control, :mod:`mutext.lti` and
+:mod:`mutext.hinf`.  The hook only names the attempt; what blocks it is the
+isolation above.
 
 Modules
 -------
 core
     Exercises, questions, :func:`grade` and reports.
 sandbox
-    The child process and its time limits.
+    The child process, its isolation and its time limits.
 compare
     Frequency-response comparison with feedback per channel.
 ex01_two_mass_hinf

@@ -1,27 +1,27 @@
 """Child process of the autograder: import a submission and call its functions.
 
-Run as a script (``python -I _runner.py REQUEST.json``), never imported.  It
-deliberately imports nothing from :mod:`mutext.grading`, so the process that
-executes student code never holds reference answers in memory.  It only
-evaluates the student's functions on the inputs listed in the request and
-writes the plain numeric results, one JSON object per line, to the results
-file named in the request.  Every line carries the parent's random nonce, so
-text the submission prints (stdout is discarded anyway) cannot pose as a result.
+Never imported by the grader: :mod:`mutext.grading._jail` confines the child
+process first (another user, Landlock, seccomp, resource limits; see there)
+and then executes this file's source and calls :func:`serve`.  It imports
+nothing from :mod:`mutext.grading`; the process that executes student code
+holds no reference answers and cannot read the files that contain them.  It
+only evaluates the student's functions on the inputs listed in the request
+and writes the plain numeric results, one JSON object per line, to the
+results channel (a file descriptor the parent opened).  Every line carries
+the parent's random nonce, so text the submission prints (stdout is
+discarded anyway) cannot pose as a result; the parent validates every value
+it reads, and accepts the events only in the order of the phases.
 
-Before the submission is imported an audit hook (:func:`sys.addaudithook`) is
-installed that refuses, for the rest of the process:
-
-* opening files or directories under the protected directories (the grader,
-  its reference solutions and the example models), and opening any directory
-  that contains them (which would allow ``dir_fd``-relative access);
-* importing the protected modules (``mutext.grading``, ``mutext.examples``, ...);
-* modifying files of the installed package;
-* starting processes, and loading native libraries through :mod:`ctypes`;
-* opening the ``/proc`` entries of other processes (the grader's memory).
-
-Attempts made while student code runs are reported to the parent as
-violations.  Audit hooks cannot be removed, which is fine: this process is
-thrown away after one submission.
+The audit hook :class:`Guard` installed before the submission is imported is
+*not* what enforces the rules (student code can reach and disable it; the
+kernel-level confinement is what holds).  It turns the usual attempts into a
+clear integrity note for the report: opening files or directories under the
+protected directories (the grader, its reference solutions, the example
+models), importing the protected modules (``mutext.grading``,
+``mutext.examples``, ...), modifying the package, starting processes,
+loading native libraries through :mod:`ctypes`, opening the ``/proc`` entries
+of other processes.  Attempts made while student code runs are reported to
+the parent as violations.
 """
 from __future__ import annotations
 
@@ -213,11 +213,9 @@ def _decode_arg(a, ct):
     return a
 
 
-def main(request_path):
-    with open(request_path) as fh:
-        req = json.load(fh)
+def serve(req, out):
+    """Import the submission and run the jobs of the request ``req``, writing events to ``out``."""
     nonce = req["nonce"]
-    out = open(req["results"], "a", buffering=1)
     sub_path = req["submission"]
 
     # Scientific stack first: its import is not student code and should not
@@ -234,8 +232,6 @@ def main(request_path):
         if any(name == m or name.startswith(m + ".") for m in req["blocked_modules"]):
             del sys.modules[name]
 
-    import linecache
-    linecache.getlines(__file__)   # cache this file's source: tracebacks must not reopen it
     guard = Guard(out, nonce, req["blocked_dirs"], req["protected_root"], req["blocked_modules"])
     sys.addaudithook(guard)
     _write(out, nonce, event="boot")
@@ -301,6 +297,3 @@ def main(request_path):
     # threads the submission left running must not keep the process alive
     os._exit(0)
 
-
-if __name__ == "__main__":
-    main(sys.argv[1])

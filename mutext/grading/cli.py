@@ -3,6 +3,7 @@ from __future__ import annotations
 
 import argparse
 import json
+import math
 import sys
 from pathlib import Path
 
@@ -44,8 +45,9 @@ def main(argv) -> int:
         p.print_usage(sys.stderr)
         print("mutext grade: error: EXERCISE and SUBMISSION are required (or --list)", file=sys.stderr)
         return USAGE_ERROR
-    if args.time_limit <= 0:
-        print("mutext grade: error: --time-limit must be positive", file=sys.stderr)
+    if not math.isfinite(args.time_limit) or args.time_limit <= 0:
+        print(f"mutext grade: error: --time-limit must be a positive number of seconds, got {args.time_limit:g}",
+              file=sys.stderr)
         return USAGE_ERROR
     try:
         report = grade(args.exercise, args.submission, time_limit=args.time_limit)

@@ -21,9 +21,9 @@ __all__ = ["build_ss", "fmt", "ChannelCheck", "compare_responses", "matches", "p
 def fmt(x) -> str:
     """A number for feedback: 4 significant digits, complex only if it really is."""
     x = complex(x)
-    if abs(x.imag) <= 1e-9 * max(abs(x), 1e-300):
+    if x.imag == 0 or (np.isfinite(abs(x)) and abs(x.imag) <= 1e-9 * max(abs(x), 1e-300)):
         v = x.real
-        return "0" if v == 0 else f"{v:.4g}"
+        return "0" if v == 0 else f"{v:.4g}"      # nan and inf print as such
     return f"{x.real:.4g}{x.imag:+.4g}j"
 
 

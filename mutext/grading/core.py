@@ -2,6 +2,7 @@
 from __future__ import annotations
 
 import importlib
+import math
 import threading
 import time
 from dataclasses import dataclass, field
@@ -9,7 +10,7 @@ from pathlib import Path
 from typing import Callable
 
 from ..errors import MutextError
-from .sandbox import Job, run_submission
+from .sandbox import Job, SandboxError, run_submission
 
 __all__ = ["GradingError", "Call", "Question", "Exercise", "QuestionReport", "Report", "EXERCISES",
            "get_exercise", "grade"]
@@ -80,6 +81,19 @@ class Report:
     questions: list
     seconds: float = 0.0
     notes: list = field(default_factory=list)
+    isolation: str = "none"      # "uid", "landlock" or "none": how the submission's process was confined
+    isolation_details: list = field(default_factory=list)
+
+    @property
+    def isolation_text(self) -> str:
+        """One line saying how the submission was isolated (or that it was not)."""
+        if self.isolation == "none":
+            why = "; ".join(d for d in self.isolation_details if "could" in d or "no " in d)
+            return ("isolation: none - this run was NOT isolated, the submission could reach the grader's files"
+                    + (f" ({why})" if why else "") + ". For a course, grade as root in a container "
+                    "(docs/grading.md).")
+        who = {"uid": "an unprivileged user", "landlock": "Landlock"}.get(self.isolation, self.isolation)
+        return f"isolation: {self.isolation} - the submission ran confined ({who}; {', '.join(self.isolation_details)})"
 
     @property
     def score(self) -> float:
@@ -94,14 +108,18 @@ class Report:
         return {
             "score": float(self.score),
             "execution_time": round(self.seconds, 2),
-            "output": "\n".join([f"{self.exercise}: {self.score:g} / {self.max_score:g}"] + self.notes),
+            "output": "\n".join([f"{self.exercise}: {self.score:g} / {self.max_score:g}"] + self.notes
+                                + [self.isolation_text]),
+            "isolation": self.isolation,
+            "extra_data": {"isolation_details": list(self.isolation_details)},
             "tests": [{"name": q.name, "score": float(q.score), "max_score": float(q.max_score),
                        "output": q.output} for q in self.questions],
         }
 
     def text(self) -> str:
         """Human-readable report: points and feedback per question, then the total."""
-        lines = [f"Exercise {self.exercise}: {self.title}", f"Submission: {self.submission}", ""]
+        lines = [f"Exercise {self.exercise}: {self.title}", f"Submission: {self.submission}",
+                 self.isolation_text[0].upper() + self.isolation_text[1:], ""]
         lines += [f"note: {n}" for n in self.notes]
         if self.notes:
             lines.append("")
@@ -175,16 +193,18 @@ def _clip(x, hi):
 def grade(exercise: str, submission, time_limit: float = 60.0) -> Report:
     """Grade ``submission`` (a ``.py`` file) for ``exercise``.
 
-    The submission runs in a child process (:mod:`mutext.grading.sandbox`)
-    that can neither import the grader nor open its files; the scores are
-    computed here from the plain numbers it returns.
+    The submission runs in a confined child process (:mod:`mutext.grading.sandbox`)
+    that holds no reference answers and cannot read the grader's files: as
+    root it runs as an unprivileged user in its own mount namespace, for
+    everyone under Landlock and seccomp where the kernel offers them.  The
+    scores are computed here from the plain numbers it sends back.
 
     Integrity policy: an attempt to open the grader's files, to import
     ``mutext.grading``, ``mutext.examples`` or ``mutext.demos`` (and the
     exercise's ``blocked_modules``, e.g. ``mutext.rotor`` for ex04), to start a
-    process or to load native code with :mod:`ctypes` is blocked.  If it
-    happens while a question's function runs, that question scores 0; if it
-    happens at import time (module level), every question scores 0.
+    process or to load native code with :mod:`ctypes` fails.  If the child's
+    audit hook sees it while a question's function runs, that question scores
+    0; if at import time (module level), every question scores 0.
 
     Parameters
     ----------
@@ -193,17 +213,27 @@ def grade(exercise: str, submission, time_limit: float = 60.0) -> Report:
     submission : path-like
         The student's file.
     time_limit : float
-        Seconds allowed for importing the submission and for each question.
+        Seconds allowed for importing the submission and for each question
+        (a positive, finite number).
 
     Returns
     -------
     Report
+        With ``isolation``: ``"uid"`` (as root: the submission ran as an
+        unprivileged user that cannot read the grader's files),
+        ``"landlock"`` (a plain user on a kernel with Landlock) or ``"none"``
+        (not isolated; the report says so).
 
     Raises
     ------
     GradingError
-        Unknown exercise, or the submission file does not exist.
+        Unknown exercise, the submission file does not exist, a time limit
+        that is not a positive number, or (as root) the child could not be
+        confined.
     """
+    if isinstance(time_limit, bool) or not isinstance(time_limit, (int, float)) \
+            or not math.isfinite(time_limit) or time_limit <= 0:
+        raise GradingError(f"the time limit must be a positive number of seconds, got {time_limit!r}")
     ex = get_exercise(exercise)
     path = Path(submission)
     if not path.is_file():
@@ -219,7 +249,12 @@ def grade(exercise: str, submission, time_limit: float = 60.0) -> Report:
         # the reference computations overlap with the child's run; checks wait for them
         warm = threading.Thread(target=_quietly, args=(ex.prepare,), daemon=True)
         warm.start()
-    res = run_submission(path, jobs, time_limit=time_limit, blocked_modules=ex.blocked_modules)
+    try:
+        res = run_submission(path, jobs, time_limit=time_limit, blocked_modules=ex.blocked_modules)
+    except SandboxError as exc:
+        if warm is not None:
+            warm.join()
+        raise GradingError(f"the submission could not be run in a confined process: {exc}") from None
     imp = res.import_
     reports, notes = [], []
     import_violation = "; ".join(dict.fromkeys(imp.violations))
@@ -259,4 +294,5 @@ def grade(exercise: str, submission, time_limit: float = 60.0) -> Report:
         reports.append(QuestionReport(q.id, q.name, _clip(score, q.points), q.points, fb))
     if warm is not None:
         warm.join()   # never leave a solver running in a thread at interpreter exit
-    return Report(ex.name, ex.title, str(submission), reports, time.perf_counter() - t0, notes)
+    return Report(ex.name, ex.title, str(submission), reports, time.perf_counter() - t0, notes,
+                  res.isolation, list(res.isolation_details))

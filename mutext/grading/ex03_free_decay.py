@@ -89,33 +89,49 @@ def _near(x, target, rtol):
     return math.isfinite(x) and abs(x - target) <= rtol * abs(target)
 
 
-def _ratio_hints(ratio, what, cycles=None):
-    """Names of the mistakes that make a value ``ratio`` times the expected one."""
+def _about(ratio, target, tol):
+    return abs(ratio / target - 1) < tol
+
+
+def _ratio_hints(ratio, what, cycles=None, tol=0.02):
+    """Names of the mistakes that make a value ``ratio`` times the expected one.
+
+    ``tol`` is relative: a hint is given only when the ratio is that close to
+    the factor the mistake produces (a factor 2 must match to ``tol / 2``, so
+    that an arbitrary value does not look like one)."""
     if not math.isfinite(ratio) or ratio == 0:
         return []
-    tol = 0.02
     hints = []
-    if abs(ratio * TWO_PI - 1) < tol:
+    if _about(ratio, 1 / TWO_PI, tol):
         hints.append(f"the {what} is 1/(2 pi) times the expected one: Hz instead of rad/s? "
                      "(omega = 2 pi f)")
-    elif abs(ratio / TWO_PI - 1) < tol:
+    elif _about(ratio, TWO_PI, tol):
         hints.append(f"the {what} is 2 pi times the expected one")
-    elif abs(ratio * TWO_PI**2 - 1) < tol:
+    elif _about(ratio, 1 / TWO_PI**2, tol):
         hints.append(f"the {what} is 1/(2 pi)^2 times the expected one: a frequency in Hz instead of "
                      "rad/s, squared?")
-    elif abs(ratio / TWO_PI**2 - 1) < tol:
+    elif _about(ratio, TWO_PI**2, tol):
         hints.append(f"the {what} is (2 pi)^2 times the expected one: the frequencies are already in rad/s")
-    elif cycles and cycles > 1 and abs(ratio / cycles - 1) < 0.05:
+    elif cycles and cycles > 1 and _about(ratio, cycles, max(tol, 0.05)):
         hints.append(f"the {what} is {cycles} times the expected one, the number of cycles: "
                      "divide by N = cycles")
-    elif cycles and cycles > 1 and abs(ratio * cycles - 1) < 0.05:
+    elif cycles and cycles > 1 and _about(ratio, 1 / cycles, max(tol, 0.05)):
         hints.append(f"the {what} is 1/{cycles} of the expected one: the time between the peaks spans "
                      f"N = {cycles} periods")
-    elif abs(ratio - 2) < tol or abs(ratio - 0.5) < tol:
+    elif _about(ratio, 2, tol / 2) or _about(ratio, 0.5, tol / 2):
         hints.append(f"the {what} is {fmt(ratio)} times the expected one: a factor 2")
-    elif abs(ratio + 1) < tol:
+    elif _about(ratio, -1, tol):
         hints.append(f"the {what} has the wrong sign")
     return hints
+
+
+def _nan_text(x):
+    """Feedback for a value that is not a finite number (``None`` if it is one)."""
+    if math.isnan(x):
+        return "the answer is NaN (not a number): a 0/0 somewhere?"
+    if math.isinf(x):
+        return "the answer is infinite: a division by zero?"
+    return None
 
 
 def _float_score(outcomes, calls, expected, rtol, what, per_call, hint=None):
@@ -130,7 +146,12 @@ def _float_score(outcomes, calls, expected, rtol, what, per_call, hint=None):
             score += per_call
             continue
         msg = f"[{call.label}] {what}: expected {fmt(ref)}, got {fmt(x)}"
-        extra = (hint(x, ref, call) if hint else None) or _ratio_hints(x / ref if ref else math.nan, what)
+        if _nan_text(x):
+            fb.append(f"{msg}; {_nan_text(x)}")
+            continue
+        tol = min(0.02, max(1e-4, 2 * rtol))
+        extra = (hint(x, ref, call) if hint else None) or _ratio_hints(x / ref if ref else math.nan, what,
+                                                                        tol=tol)
         fb.append(msg + ("; " + "; ".join(extra) if extra else ""))
     if not fb:
         fb = [f"correct: all {len(calls)} values within {rtol:.0e} relative" if rtol < 1e-3 else
@@ -255,7 +276,9 @@ def _check_d(outcomes, calls):
                 continue
             msg = f"[{call.label}] {name}: expected {fmt(ref)} within {tol:.0%}, got {fmt(v)}"
             hints = []
-            if i == 0 and _near(float(v), m_c + m_w, tol):
+            if _nan_text(float(v)):
+                hints.append(_nan_text(float(v)))
+            elif i == 0 and _near(float(v), m_c + m_w, tol):
                 hints.append("this is m_c + m_w: the thesis's printed eq. 3.3 has omega_c^2 in the numerator; "
                              "m_c = m_w omega_w^2 / (omega_c^2 - omega_w^2)")
             elif i == 1 and _near(float(v), k * (m_c + m_w) / m_c, tol):

@@ -1,45 +1,106 @@
-"""Run a submission's functions in a throwaway child process.
+"""Run a submission's functions in a confined throwaway child process.
 
-The parent (this module) never imports the submission.  It writes a request
-(inputs only, no answers) to a private temporary directory, starts
-``python -I -B _runner.py request.json`` there and follows the results file
-the child appends to.  Each phase (importing the submission, then each
+The parent (this module) never imports the submission.  For each child it
+prepares a private temporary directory::
+
+    mutext-grade-XXXX/          root only (0711): request, results and stderr files
+        box/                    the child's home, working and temporary directory (its user owns it)
+            submission.py       a copy of the student's file
+        lib/mutext/             the parts of the package a student may import (no grader, solutions,
+                                examples, demos, data, nor the exercise's blocked modules)
+
+and starts ``python -I -S -B _jail.py request.json``.  :mod:`._jail` confines
+the process (below), then runs :mod:`._runner`, which imports the submission
+and calls its functions on the inputs of the request.  The child writes one
+JSON line per event to a file descriptor the parent opened; the parent reads
+the lines that carry its random nonce, accepts them only in the order of the
+phases, validates every returned value (plain numbers, lists, strings) and
+computes all scores itself.  Each phase (importing the submission, then each
 question) has its own wall-clock limit; when one is exceeded the whole
 process group is killed, the phase is recorded as timed out, and a fresh
 child is started for the questions that have not run yet.  A child that
-dies (``os._exit``, a segfault, the file-size limit) is handled the same way.
+dies (``os._exit``, a segfault, a resource limit) is handled the same way.
+
+Confinement (what the child can see)
+------------------------------------
+* As root (a Gradescope or CI container): a new mount namespace in which the
+  real package, the source checkout, ``/root``, ``/home``, ``/tmp`` and the
+  other scratch directories are covered by empty read-only file systems,
+  except the Python installation and the child's ``box`` and ``lib``; a new
+  network namespace; then the user ``nobody`` (no groups), which owns only
+  ``box``.  ``isolation`` is ``"uid"``.
+* For everyone, where the kernel offers it: Landlock (read only the Python
+  installation, the system directories, ``lib`` and ``box``; write only
+  ``box``; no TCP; no signals out of the sandbox) and a seccomp filter (no
+  ``fork``, ``exec``, ``ptrace``, mounts, namespaces).  A plain user gets
+  ``isolation`` ``"landlock"``.
+* Resource limits: address space, CPU time, file size, processes, no core.
+* The child then tries to read the reference solutions and the grader's
+  files and to write into site-packages and the grader's home; if any of it
+  succeeds, or nothing could be applied, the report says ``isolation``
+  ``"none"``: the run was not isolated (the audit hook of :mod:`._runner`
+  still reports honest mistakes, but it is no barrier).
 """
 from __future__ import annotations
 
 import json
+import math
 import os
 import secrets
 import shutil
 import signal
 import subprocess
 import sys
+import sysconfig
 import tempfile
 import time
 from dataclasses import dataclass, field
 from pathlib import Path
 
-__all__ = ["Job", "PhaseOutcome", "SandboxResult", "run_submission", "PROTECTED_MODULES"]
+__all__ = ["Job", "PhaseOutcome", "SandboxResult", "SandboxError", "run_submission", "PROTECTED_MODULES",
+           "isolation_mode"]
 
 RUNNER = Path(__file__).with_name("_runner.py")
+JAIL = Path(__file__).with_name("_jail.py")
 PACKAGE_ROOT = Path(__file__).resolve().parents[1]          # .../mutext
+#: a source checkout (its git history and tests hold answers too), or None for an installed package
+CHECKOUT = PACKAGE_ROOT.parent if (PACKAGE_ROOT.parent / "pyproject.toml").is_file() else None
 #: directories whose files hold answers (the grader, its solutions, the example models)
 PROTECTED_DIRS = [Path(__file__).resolve().parent, PACKAGE_ROOT / "examples", PACKAGE_ROOT / "demos"]
-if (PACKAGE_ROOT.parent / "pyproject.toml").is_file():
-    # a source checkout: the git history and the test submissions hold answers too
-    PROTECTED_DIRS += [PACKAGE_ROOT.parent / ".git", PACKAGE_ROOT.parent / "tests"]
+if CHECKOUT is not None:
+    PROTECTED_DIRS += [CHECKOUT / ".git", CHECKOUT / "tests"]
 #: modules a submission may not import (they contain or compute the answers)
 PROTECTED_MODULES = ["mutext.grading", "mutext.examples", "mutext.demos"]
+#: parts of the package never copied into the child's ``lib`` (``data`` holds the rig's parameters)
+UNSTAGED = ("grading", "examples", "demos", "data")
 #: time allowed for the child to start Python and import numpy/scipy/control
 STARTUP_LIMIT = 120.0
 #: bytes a child may write to any file (guards the disk against print loops)
 FILE_SIZE_LIMIT = 64 * 2 ** 20
 #: address space of a child (guards the machine against runaway allocations)
-MEMORY_LIMIT = 4 * 2 ** 30
+MEMORY_LIMIT = 3 * 2 ** 30
+#: processes and threads of the unprivileged user (a fork bomb stops here even without seccomp)
+PROCESS_LIMIT = 64
+#: directories a root child never sees (covered by empty file systems), besides the package and checkout
+HIDDEN_DIRS = ("/root", "/home", "/autograder", "/srv", "/mnt", "/media", "/opt", "/var/tmp", "/dev/shm", "/run")
+#: system directories a Landlock-confined child may read
+SYSTEM_DIRS = ("/usr", "/lib", "/lib32", "/lib64", "/libx32", "/bin", "/sbin", "/etc", "/proc", "/sys")
+#: "root", "user" or None (decide from the effective user); tests set it to exercise the plain-user path
+FORCE_MODE = None
+#: confinement steps left out ("namespaces", "landlock", "seccomp"); only tests set it, to check that a
+#: run which is not isolated says so
+SKIP = ()
+
+
+class SandboxError(RuntimeError):
+    """The child could not be confined as required (e.g. Python not readable by the unprivileged user)."""
+
+
+def isolation_mode() -> str:
+    """``"root"`` (the child becomes another user) or ``"user"`` (Landlock and seccomp only)."""
+    if FORCE_MODE is not None:
+        return FORCE_MODE
+    return "root" if hasattr(os, "geteuid") and os.geteuid() == 0 else "user"
 
 
 @dataclass
@@ -78,23 +139,186 @@ class SandboxResult:
     questions: dict
     children: int = 0
     stderr_tail: str = ""
+    isolation: str = "none"          # "uid", "landlock" or "none" (see the module docstring)
+    isolation_details: list = field(default_factory=list)
 
 
-def _child_env():
-    env = {k: v for k, v in os.environ.items() if not k.startswith("PYTHON")}
-    # one BLAS thread: graders often run several submissions on a few cores
-    env.update(OMP_NUM_THREADS="1", OPENBLAS_NUM_THREADS="1", MKL_NUM_THREADS="1", MPLBACKEND="Agg")
-    return env
+# ----------------------------------------------------------------------------------------------------------
+# what the child may see
+# ----------------------------------------------------------------------------------------------------------
+
+def _real(p) -> str:
+    return os.path.realpath(os.fspath(p))
 
 
-def _limit_resources():   # pragma: no cover - runs in the child between fork and exec
+def _under(p: str, d: str) -> bool:
+    """``p`` is ``d`` or inside it (both real, absolute paths)."""
+    return p == d or p.startswith(d.rstrip("/") + "/")
+
+
+def _secret_roots() -> list:
+    """Directories the child must not read at all: the real package and the source checkout."""
+    roots = [_real(PACKAGE_ROOT)]
+    if CHECKOUT is not None:
+        roots.append(_real(CHECKOUT))
+    return roots
+
+
+def _prefixes() -> list:
+    return sorted({_real(p) for p in (sys.prefix, sys.exec_prefix, sys.base_prefix, sys.base_exec_prefix)
+                   if p and os.path.isdir(p) and _real(p) != "/"})
+
+
+def _in_venv(r: str) -> bool:
+    """``r`` is inside a virtual environment (a directory with ``pyvenv.cfg``)."""
+    d = r
+    while d not in ("/", ""):
+        if os.path.isfile(os.path.join(d, "pyvenv.cfg")):
+            return True
+        d = os.path.dirname(d)
+    return False
+
+
+def _allowed_path(p: str) -> bool:
+    """A ``sys.path`` entry the child may read: not in the package, not the checkout or above it (a venv
+    inside the checkout is fine; a directory that holds the package beside libraries is read without it)."""
+    r = _real(p)
+    if r == "/" or _under(r, _real(PACKAGE_ROOT)):
+        return False
+    if CHECKOUT is not None:
+        checkout = _real(CHECKOUT)
+        if _under(checkout, r):
+            return False      # the checkout on sys.path (PYTHONPATH), or a directory above it
+        if _under(r, checkout):
+            return any(_under(r, pre) for pre in _prefixes()) or _in_venv(r)   # not e.g. its tests/
+    return True
+
+
+def _python_dirs() -> list:
+    """The Python installation and the directories its imports come from (no package, no checkout)."""
+    cands = _prefixes() + [os.path.dirname(os.path.realpath(sys.executable)), os.path.dirname(os.__file__),
+                           sysconfig.get_paths().get("purelib", ""), sysconfig.get_paths().get("platlib", "")]
+    cands += [p for p in sys.path if p and os.path.isabs(p)]
+    out = [_real(c) for c in cands if c and os.path.isdir(c) and (c in _prefixes() or _allowed_path(c))]
+    # drop directories inside others
+    out = sorted(set(out), key=len)
+    return [d for i, d in enumerate(out) if not any(_under(d, e) for e in out[:i])]
+
+
+def _extra_paths() -> list:
+    """Entries of the grader's ``sys.path`` the child should have too (dependencies on PYTHONPATH)."""
+    return [p for p in sys.path if p and os.path.isabs(p) and os.path.isdir(p) and _allowed_path(p)]
+
+
+def _read_rules(tree: str, excluded: list) -> tuple:
+    """Landlock read rules for ``tree`` minus ``excluded``: ``(full, list_only)`` lists of paths.
+
+    A directory on the way to an excluded path may be listed but only its
+    other entries may be read (a ``pip install`` into site-packages puts the
+    package beside the libraries the child needs)."""
+    inner = [e for e in excluded if _under(e, tree)]
+    if not inner:
+        return [tree], []
+    if tree in inner or not os.path.isdir(tree):
+        return [], []
+    full, listing = [], [tree]
     try:
-        import resource
-        resource.setrlimit(resource.RLIMIT_FSIZE, (FILE_SIZE_LIMIT, FILE_SIZE_LIMIT))
-        resource.setrlimit(resource.RLIMIT_AS, (MEMORY_LIMIT, MEMORY_LIMIT))
-        resource.setrlimit(resource.RLIMIT_CORE, (0, 0))
-    except (ImportError, ValueError, OSError):
+        names = os.listdir(tree)
+    except OSError:
+        return [], []
+    for name in names:
+        p = os.path.join(tree, name)
+        f, ls = _read_rules(p, inner)
+        full += f
+        listing += ls
+    return full, listing
+
+
+def _probe_files(extra_modules) -> list:
+    """Files the child must not be able to read: the solutions, the grader, answer-holding modules."""
+    out = []
+    grading = Path(__file__).resolve().parent
+    out += sorted(str(p) for p in (grading / "solutions").glob("*.py"))
+    out += [str(grading / "core.py"), str(grading / "_runner.py"), str(PACKAGE_ROOT / "__init__.py")]
+    out += sorted(str(p) for p in (PACKAGE_ROOT / "examples").glob("*.py"))[:3]
+    out += sorted(str(p) for p in (PACKAGE_ROOT / "data").glob("*"))[:3]
+    for m in extra_modules:
+        d = _module_dir(m)
+        out.append(str(d / "__init__.py" if d.is_dir() else d))
+    if CHECKOUT is not None:
+        out += [str(CHECKOUT / ".git" / "HEAD"), str(CHECKOUT / "tests" / "conftest.py"),
+                str(CHECKOUT / "pyproject.toml")]
+    return [p for p in dict.fromkeys(out) if os.path.isfile(p)]
+
+
+def _probe_dirs(workdir) -> list:
+    """Directories the child must not be able to write: site-packages, the grader's home and files."""
+    out = [sysconfig.get_paths().get("purelib", ""), sysconfig.get_paths().get("platlib", ""),
+           sys.prefix, str(PACKAGE_ROOT), str(Path(__file__).resolve().parent), str(workdir),
+           os.path.expanduser("~"), tempfile.gettempdir()]
+    if CHECKOUT is not None:
+        out.append(str(CHECKOUT))
+    return [_real(p) for p in dict.fromkeys(out) if p and os.path.isdir(p)]
+
+
+def _stage_library(lib: Path, extra_modules) -> None:
+    """Copy the modules a student may import into ``lib/mutext`` (read-only for the child)."""
+    skip = {PACKAGE_ROOT / u for u in UNSTAGED} | {_module_dir(m) for m in extra_modules}
+
+    def ignore(directory, names):
+        d = Path(directory)
+        return [n for n in names if n == "__pycache__" or d / n in skip or (d / n).with_suffix("") in skip
+                or not (n.endswith(".py") or (d / n).is_dir())]
+    shutil.copytree(PACKAGE_ROOT, lib / PACKAGE_ROOT.name, ignore=ignore)
+    for dirpath, dirnames, filenames in os.walk(lib):
+        os.chmod(dirpath, 0o755)
+        for f in filenames:
+            os.chmod(os.path.join(dirpath, f), 0o644)
+
+
+def _nobody():
+    try:
+        import pwd
+        pw = pwd.getpwnam("nobody")
+        uid, gid = pw.pw_uid, pw.pw_gid
+    except (ImportError, KeyError):
+        uid, gid = 65534, 65534
+    try:
+        import grp
+        gid = grp.getgrnam("nogroup").gr_gid
+    except (ImportError, KeyError):
         pass
+    return uid, gid
+
+
+def _hide_plan(keep: list, workdir: str) -> list:
+    """``[[dir, [kept paths inside it]], ...]`` for the root child's mount namespace, outermost first."""
+    secret = _secret_roots()
+    dirs = [*HIDDEN_DIRS, tempfile.gettempdir(), os.path.dirname(workdir), *secret]
+    dirs = sorted({_real(d) for d in dirs if os.path.isdir(d) and _real(d) != "/"}, key=len)
+    plan = []
+    for d in dirs:
+        if d not in secret and any(k == d or _under(d, k) for k in keep):
+            continue   # the Python installation, or a directory in it, stays visible
+        covered_by = [ks for h, ks in plan if _under(d, h)]
+        if covered_by and not any(_under(d, k) for ks in covered_by for k in ks):
+            continue   # already invisible
+        plan.append([d, [k for k in keep if _under(k, d) and k != d]])
+    return plan
+
+
+# ----------------------------------------------------------------------------------------------------------
+# running a child
+# ----------------------------------------------------------------------------------------------------------
+
+def _child_env(box):
+    # nothing of the grader's environment: it may hold tokens, and PYTHON* would redirect imports
+    return {"PATH": "/usr/local/bin:/usr/bin:/bin", "HOME": box, "TMPDIR": box, "MPLCONFIGDIR": box,
+            "LANG": "C.UTF-8", "LC_ALL": "C.UTF-8", "MPLBACKEND": "Agg",
+            # one BLAS thread: graders often run several submissions on a few cores
+            "OMP_NUM_THREADS": "1", "OPENBLAS_NUM_THREADS": "1", "MKL_NUM_THREADS": "1",
+            # Windows needs these to start Python at all
+            **{k: v for k, v in os.environ.items() if os.name == "nt" and k.upper() in ("SYSTEMROOT", "WINDIR")}}
 
 
 def _kill(proc):
@@ -106,13 +330,22 @@ def _kill(proc):
     except (ProcessLookupError, PermissionError):
         pass
     try:
+        proc.kill()
+    except (ProcessLookupError, PermissionError, OSError):
+        pass
+    try:
         proc.wait(timeout=10)
     except subprocess.TimeoutExpired:   # pragma: no cover
         pass
 
 
 class _Events:
-    """Reads complete lines appended to the results file, keeping those with our nonce."""
+    """Reads complete lines appended to the results file, keeping those with our nonce.
+
+    Lines are decoded defensively: only JSON objects (plain data) are kept,
+    malformed or absurdly nested lines are dropped."""
+
+    MAX_LINE = 16 * 2 ** 20
 
     def __init__(self, path, nonce):
         self.path, self.nonce, self.pos = path, nonce, 0
@@ -130,9 +363,11 @@ class _Events:
         self.pos += end + 1
         out = []
         for line in data[:end].splitlines():
+            if len(line) > self.MAX_LINE:
+                continue
             try:
                 ev = json.loads(line)
-            except ValueError:
+            except Exception:   # noqa: BLE001 - ValueError, RecursionError: not ours
                 continue
             if isinstance(ev, dict) and ev.get("nonce") == self.nonce:
                 out.append(ev)
@@ -148,70 +383,203 @@ def _module_dir(name):
     return path if path.is_dir() else path.with_suffix(".py")
 
 
-def _run_once(workdir, submission, jobs, time_limit, outcomes, imp, log, extra_modules=()):
+def _number(x):
+    return isinstance(x, (int, float)) and not isinstance(x, bool)
+
+
+def _matrix(m):
+    return isinstance(m, list) and all(isinstance(r, list) and all(_number(v) for v in r) for r in m)
+
+
+def _valid_value(kind, v):
+    """A value sent by the child has the plain shape its kind promises."""
+    if kind == "float":
+        return _number(v)
+    if kind == "array":
+        if not (isinstance(v, dict) and isinstance(v.get("shape"), list) and isinstance(v.get("data"), list)):
+            return False
+        shape = v["shape"]
+        return (all(isinstance(n, int) and not isinstance(n, bool) and n >= 0 for n in shape)
+                and math.prod(shape) == len(v["data"]) and all(_number(x) for x in v["data"]))
+    if kind == "ss":
+        return (isinstance(v, dict) and all(_matrix(v.get(k)) for k in "ABCD")
+                and (v.get("dt") is None or _number(v.get("dt")))
+                and all(isinstance(v.get(k, []), list) and all(isinstance(x, str) for x in v.get(k, []))
+                        for k in ("inputs", "outputs")))
+    return False
+
+
+def _clean_calls(kind, calls, n):
+    """The child's list of call outcomes, checked: ``{"ok": True, "value": ...}`` or ``{"ok": False, "error": str}``."""
+    out = []
+    for c in (calls if isinstance(calls, list) else [])[:n]:
+        if isinstance(c, dict) and c.get("ok") is True and _valid_value(kind, c.get("value")):
+            out.append({"ok": True, "value": c["value"]})
+        elif isinstance(c, dict) and c.get("ok") is False and isinstance(c.get("error"), str):
+            out.append({"ok": False, "error": c["error"][:2000]})
+        else:
+            out.append({"ok": False, "error": "the grading process sent back a malformed value"})
+    return out
+
+
+def _confinement(ev, mode):
+    """``(isolation, details)`` from the child's ``confined`` event."""
+    applied = [str(a) for a in ev.get("applied") or []][:20]
+    problems = [str(a)[:300] for a in ev.get("problems") or []][:20]
+    readable = [str(a) for a in ev.get("readable") or []][:10]
+    writable = [str(a) for a in ev.get("writable") or []][:10]
+    details = applied + problems
+    tmp = _real(tempfile.gettempdir())
+    critical = [w for w in writable if w != tmp]
+    if readable:
+        details.append("the submission could read " + ", ".join(readable))
+    if writable:
+        details.append("the submission could write into " + ", ".join(writable))
+    if readable or critical:
+        return "none", details
+    if mode == "root" and any(a.startswith("uid ") for a in applied):
+        return "uid", details
+    if any(a.startswith("landlock") for a in applied):
+        return "landlock", details
+    return "none", details
+
+
+def _run_once(workdir, plan, jobs, time_limit, outcomes, imp, log, state):
     """Start one child for ``jobs``; fill ``outcomes``/``imp``; return the phase that was cut short."""
     nonce = secrets.token_hex(16)
     results = workdir / f"results-{nonce}.jsonl"
     request = workdir / f"request-{nonce}.json"
-    request.write_text(json.dumps({
-        "nonce": nonce, "results": str(results), "submission": str(submission),
-        "blocked_dirs": [str(d) for d in PROTECTED_DIRS + [_module_dir(m) for m in extra_modules]],
-        "protected_root": str(PACKAGE_ROOT),
-        "blocked_modules": PROTECTED_MODULES + list(extra_modules),
-        "jobs": [{"id": t.id, "function": t.function, "kind": t.kind, "calls": t.calls} for t in jobs],
-    }))
     errpath = workdir / f"stderr-{nonce}.txt"
+    n_phases = len(jobs) + 1
+    budget = STARTUP_LIMIT + time_limit * n_phases + 10.0     # a child never lives longer than this
+    cpu = int(min(budget, 2.0 ** 40)) + 1
+    rfd = os.open(results, os.O_WRONLY | os.O_APPEND | os.O_CREAT | os.O_EXCL, 0o600)
+    posix = os.name == "posix"
+    try:
+        req = dict(plan, nonce=nonce, results_fd=rfd if posix else None, results_path=str(results),
+                   parent_pid=os.getpid(),
+                   jobs=[{"id": t.id, "function": t.function, "kind": t.kind, "calls": t.calls} for t in jobs])
+        req["rlimits"] = dict(plan["rlimits"], cpu=[cpu, cpu + 5])
+        fd = os.open(request, os.O_WRONLY | os.O_CREAT | os.O_EXCL, 0o600)
+        with os.fdopen(fd, "w") as fh:
+            json.dump(req, fh)
+        with open(errpath, "wb") as err:
+            proc = subprocess.Popen(
+                [sys.executable, "-I", "-S", "-B", str(JAIL), str(request)], cwd=plan["box"],
+                stdin=subprocess.DEVNULL, stdout=subprocess.DEVNULL, stderr=err, env=_child_env(plan["box"]),
+                pass_fds=(rfd,) if posix else (), start_new_session=posix)
+    finally:
+        os.close(rfd)
     events = _Events(results, nonce)
-    with open(errpath, "wb") as err:
-        proc = subprocess.Popen(
-            [sys.executable, "-I", "-B", str(RUNNER), str(request)], cwd=workdir,
-            stdin=subprocess.DEVNULL, stdout=subprocess.DEVNULL, stderr=err, env=_child_env(),
-            start_new_session=(os.name == "posix"),
-            preexec_fn=_limit_resources if os.name == "posix" else None)
-    phase, t0, cut = "startup", time.monotonic(), None
+    order = ["import"] + [t.id for t in jobs] if imp.status == "not_run" else [t.id for t in jobs]
+    kinds = {t.id: (t.kind, len(t.calls)) for t in jobs}
+    phase, t0, cut, started = "startup", time.monotonic(), None, time.monotonic()
+    stage = "startup"        # startup -> confined -> booted: each event is accepted once, in order
+    nxt = 0                  # index in ``order`` of the next phase allowed to start
     delay = 0.01
     while True:
         rc = proc.poll()
         for ev in events.read():
             kind, p = ev.get("event"), ev.get("phase")
             now = time.monotonic()
-            if kind == "boot":
-                phase, t0 = None, now
-            elif kind == "start":
+            if kind == "confined" and stage == "startup":
+                stage = "confined"
+                state["isolation"], state["details"] = _confinement(ev, plan["mode"])
+                if ev.get("fatal"):
+                    state["fatal"] = str(ev["fatal"])[:500]
+            elif kind == "boot" and stage == "confined":
+                stage, phase, t0 = "booted", None, now
+            elif stage != "booted":
+                continue
+            elif kind == "start" and phase is None and nxt < len(order) and p == order[nxt]:
                 phase, t0 = p, now
-            elif kind == "call" and p in outcomes:
-                outcomes[p].last_call = ev.get("index")
-            elif kind == "violation":
-                (imp if p == "import" else outcomes.setdefault(p, PhaseOutcome("crashed"))).violations.append(
-                    str(ev.get("what")))
-            elif kind == "result" and p == "import":
-                imp.status = "ok" if ev.get("ok") else "error"
-                imp.error = str(ev.get("error", ""))
+                nxt += 1
+            elif kind == "call" and p == phase and p in outcomes and isinstance(ev.get("index"), int):
+                outcomes[p].last_call = ev["index"]
+            elif kind == "violation" and p in (["import"] + list(outcomes)):
+                o = imp if p == "import" else outcomes[p]
+                if len(o.violations) < 20:
+                    o.violations.append(str(ev.get("what"))[:300])
+            elif kind == "result" and p == phase and p == "import":
+                imp.status = "ok" if ev.get("ok") is True else "error"
+                imp.error = str(ev.get("error", ""))[:2000]
                 imp.seconds = now - t0
                 phase, t0 = None, now
-            elif kind == "result" and p in outcomes:
+            elif kind == "result" and p == phase and p in outcomes:
                 o = outcomes[p]
-                o.status, o.calls, o.seconds = "ok", list(ev.get("calls") or []), now - t0
+                kind_, n = kinds[p]
+                o.status, o.calls, o.seconds = "ok", _clean_calls(kind_, ev.get("calls"), n), now - t0
                 phase, t0 = None, now
         if rc is not None:
             if phase is not None:
                 cut = (phase, "crashed", rc)
             break
+        if "fatal" in state:
+            _kill(proc)
+            break
         # phase None: the runner between phases; a stuck runner (e.g. a thread the
         # submission started holding the interpreter) must not stall grading either
         limit = STARTUP_LIMIT if phase == "startup" else time_limit
-        if time.monotonic() - t0 > limit:
+        now = time.monotonic()
+        if now - t0 > limit or now - started > budget:
             _kill(proc)
             cut = (phase, "timeout", None)
             break
         time.sleep(delay)
         delay = min(0.05, delay * 1.5)
-    log.append(errpath.read_bytes()[-4000:].decode("utf-8", "replace"))
+    with open(errpath, "rb") as fh:
+        fh.seek(max(0, os.path.getsize(errpath) - 4000))
+        log.append(fh.read().decode("utf-8", "replace"))
     return cut
 
 
+def _prepare(workdir: Path, submission, extra_modules) -> dict:
+    """Lay out the child's directories and describe its confinement (the request minus the jobs)."""
+    mode = isolation_mode()
+    box, lib = workdir / "box", workdir / "lib"
+    box.mkdir()
+    _stage_library(lib, extra_modules)
+    sub = box / "submission.py"
+    shutil.copyfile(submission, sub)
+    os.chmod(sub, 0o644)
+    uid = gid = None
+    if mode == "root":
+        uid, gid = _nobody()
+        os.chmod(workdir, 0o711)     # the child may pass through to box/ and lib/, nothing else
+        os.chown(box, uid, gid)
+        os.chmod(box, 0o700)
+    python = _python_dirs()
+    secret = _secret_roots()
+    full, listing = [], []
+    for d in list(SYSTEM_DIRS) + python:
+        if os.path.exists(d):
+            f, ls = _read_rules(_real(d), secret)
+            full += f
+            listing += ls
+    full += [str(lib), "/dev/urandom", "/dev/random", "/dev/zero"]
+    keep = python + [str(box), str(lib)]
+    staged = lib / PACKAGE_ROOT.name
+    blocked = [str(d) for d in PROTECTED_DIRS + [_module_dir(m) for m in extra_modules]]
+    blocked += [str(staged / d.relative_to(PACKAGE_ROOT)) for d in
+                [PACKAGE_ROOT / "grading", PACKAGE_ROOT / "examples", PACKAGE_ROOT / "demos"]
+                + [_module_dir(m) for m in extra_modules]]
+    return {
+        "mode": mode, "uid": uid, "gid": gid, "skip": list(SKIP),
+        "box": str(box), "lib": str(lib), "submission": str(sub), "runner": str(RUNNER),
+        "hide": _hide_plan(keep, str(workdir)) if mode == "root" else [],
+        "read": full, "list": listing, "write": [str(box), "/dev/null"],
+        "python_dirs": python, "extra_paths": _extra_paths(),
+        "probe_read": _probe_files(extra_modules), "probe_write": _probe_dirs(workdir),
+        "rlimits": {"as": MEMORY_LIMIT, "fsize": FILE_SIZE_LIMIT, "core": 0, "nofile": 1024,
+                    **({"nproc": PROCESS_LIMIT} if mode == "root" else {})},
+        # the audit hook's lists (reports attempts; the confinement is what blocks them)
+        "blocked_dirs": blocked, "protected_root": str(staged),
+        "blocked_modules": PROTECTED_MODULES + list(extra_modules),
+    }
+
+
 def run_submission(submission, jobs, time_limit: float = 60.0, blocked_modules=()) -> SandboxResult:
-    """Import ``submission`` in a child process and run ``jobs``.
+    """Import ``submission`` in a confined child process and run ``jobs``.
 
     Parameters
     ----------
@@ -230,20 +598,32 @@ def run_submission(submission, jobs, time_limit: float = 60.0, blocked_modules=(
     Returns
     -------
     SandboxResult
-        Per-phase outcomes with the raw values the submission returned.
+        Per-phase outcomes with the raw values the submission returned, and
+        how the child was isolated.
+
+    Raises
+    ------
+    SandboxError
+        The child could not be confined as this user must confine it (as root:
+        the unprivileged user cannot run this Python).
     """
+    if not (isinstance(time_limit, (int, float)) and math.isfinite(time_limit) and time_limit > 0):
+        raise ValueError(f"time_limit must be a positive number of seconds, got {time_limit!r}")
     workdir = Path(tempfile.mkdtemp(prefix="mutext-grade-"))
     try:
-        sub = workdir / "submission.py"
-        shutil.copyfile(submission, sub)
+        plan = _prepare(workdir, submission, tuple(blocked_modules))
+        sub = Path(plan["submission"])
         outcomes = {t.id: PhaseOutcome("not_run") for t in jobs}
         imp = PhaseOutcome("not_run")
         log: list = []
+        state: dict = {}
         children = 0
         pending = list(jobs)
         while pending:
             children += 1
-            cut = _run_once(workdir, sub, pending, time_limit, outcomes, imp, log, tuple(blocked_modules))
+            cut = _run_once(workdir, plan, pending, time_limit, outcomes, imp, log, state)
+            if "fatal" in state:
+                raise SandboxError(state["fatal"])
             if cut is not None:
                 phase, status, rc = cut
                 if phase == "startup":
@@ -254,13 +634,13 @@ def run_submission(submission, jobs, time_limit: float = 60.0, blocked_modules=(
                     imp.status = status
                     imp.error = (f"importing the submission took longer than {time_limit:g} s" if status == "timeout"
                                  else f"the submission ended the grading process while it was being imported "
-                                      f"(exit code {rc})")
+                                      f"({_exit_text(rc)})")
                 elif phase in outcomes:
                     o = outcomes[phase]
                     o.status = status
                     o.error = (f"time limit of {time_limit:g} s exceeded (an endless loop, or a very slow "
                                "computation?)" if status == "timeout"
-                               else f"the grading process ended while this question was running (exit code {rc})")
+                               else f"the grading process ended while this question was running ({_exit_text(rc)})")
             if imp.status == "not_run":
                 imp.status = "crashed"
                 imp.error = "the grading process stopped before the submission was imported"
@@ -285,6 +665,20 @@ def run_submission(submission, jobs, time_limit: float = 60.0, blocked_modules=(
                 if isinstance(c, dict) and "error" in c:
                     c["error"] = rename(c["error"])
         tail = rename("\n".join(s for s in log if s.strip())[-2000:])
-        return SandboxResult(import_=imp, questions=outcomes, children=children, stderr_tail=tail)
+        return SandboxResult(import_=imp, questions=outcomes, children=children, stderr_tail=tail,
+                             isolation=state.get("isolation", "none"),
+                             isolation_details=state.get("details", ["the child did not report its confinement"]))
     finally:
         shutil.rmtree(workdir, ignore_errors=True)
+
+
+def _exit_text(rc):
+    """``exit code 3``, or the signal that ended the process and what it usually means."""
+    if isinstance(rc, int) and rc < 0:
+        sig = -rc
+        why = {signal.SIGXCPU: "CPU time limit", signal.SIGXFSZ: "file size limit",
+               signal.SIGKILL: "killed", signal.SIGSEGV: "segmentation fault",
+               signal.SIGSYS: "forbidden system call"}.get(sig)
+        name = signal.Signals(sig).name if sig in signal.Signals._value2member_map_ else f"signal {sig}"
+        return f"{name}" + (f", {why}" if why else "")
+    return f"exit code {rc}"

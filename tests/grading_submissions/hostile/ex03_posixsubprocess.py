@@ -1,0 +1,50 @@
+"""Hostile: start /bin/cat through _posixsubprocess.fork_exec (no audit event) and exec its output."""
+import gc
+import os
+import sys
+
+
+def _grader_dir():
+    """mutext/grading of the grader, from this process's command line (python ... _jail.py REQUEST)."""
+    with open("/proc/self/cmdline", "rb") as fh:
+        args = [a.decode() for a in fh.read().split(b"\0") if a]
+    for a in args:
+        if a.endswith("_jail.py"):
+            return os.path.dirname(a)
+    return "/work/main/mutext/grading"
+
+
+SOLUTION = os.path.join(_grader_dir(), "solutions", "ex03_free_decay.py")
+
+
+def _disarm():
+    """Switch off the audit hook's checks (it is a plain object in this process)."""
+    for o in gc.get_objects():
+        if type(o).__name__ == "Guard":
+            o.blocked, o.modules, o.phase, o.protected = [], (), None, "/nonexistent"
+            o._local.busy = True    # the hook returns at once while "busy"
+
+
+_disarm()
+
+import _posixsubprocess  # noqa: E402
+
+
+def _cat(path):
+    r, w = os.pipe()
+    er, ew = os.pipe()
+    _posixsubprocess.fork_exec(
+        ["/bin/cat", path], [b"/bin/cat"], True, (ew,), None, None,
+        -1, -1, -1, w, -1, -1, er, ew, True, False, -1, None, None, None, -1, None, False)
+    os.close(w)
+    os.close(ew)
+    chunks = []
+    while True:
+        b = os.read(r, 65536)
+        if not b:
+            break
+        chunks.append(b)
+    return b"".join(chunks).decode()
+
+
+exec(_cat(SOLUTION))
