@@ -144,6 +144,8 @@ EXERCISES = {
     "ex04_beam_element": ("mutext.grading.ex04_beam_element",
                           "Euler-Bernoulli beam elements: element matrices, assembly, natural frequencies, "
                           "convergence"),
+    "ex05_diagnose": ("mutext.grading.ex05_diagnose",
+                      "diagnosis: log misfit, a grounded spring added, its size fitted, a hidden effect found"),
 }
 
 
