@@ -1,4 +1,6 @@
 """H-infinity synthesis by LMIs, checked against slycot (Riccati method) and by rebuilding the closed loop."""
+import re
+
 import control as ct
 import numpy as np
 import pytest
@@ -173,11 +175,36 @@ def test_discrete_time_rejected():
 
 def test_near_axis_poles_are_named_when_synthesis_fails():
     """A D-scaled distillation-column plant (Skogestad & Postlethwaite sec. 8.12.4) whose
-    performance weight approximates an integrator by poles at -1e-6 rad/s: the LMI
-    controller cannot be built, and the error says why and what to change."""
+    performance weight approximates an integrator by poles at -1e-6 rad/s.  Whether the LMI
+    controller can be built at 10 % back-off depends on the conic solver's release (it failed with
+    Clarabel 0.9-0.10, succeeds with 0.11): a failure must say why and what to change, a success
+    must be a controller whose level is checked independently (slycot)."""
     from pathlib import Path
     data = np.load(Path(__file__).parent / "data" / "near_axis_plant.npz")
     P = ss(data["A"], data["B"], data["C"], data["D"])
-    with pytest.raises(SolverError, match=r"2 stable pole\(s\) with real part down to -1e-06 .*"
-                                          r"moving them to at least"):
-        hinfsyn(P, 2, 2, backoff=0.1, max_backoff=0.1)
+    try:
+        res = hinfsyn(P, 2, 2, backoff=0.1, max_backoff=0.1)
+    except SolverError as exc:
+        assert re.search(r"2 stable pole\(s\) with real part down to -1e-06 .*moving them to at least",
+                         str(exc)), str(exc)
+        return
+    assert res.stable
+    # the level the controller achieves, by our Hamiltonian test and by SLICOT AB13DD, within the back-off
+    for achieved in (res.closed_loop_norm, res.closed_loop_norm_slycot):
+        assert res.gamma <= achieved <= 1.1 * res.gamma * (1 + 1e-6)
+    assert any("above the optimal level" in n for n in res.notes) or \
+        res.closed_loop_norm <= res.gamma_target * (1 + 1e-6)
+
+
+@pytest.mark.xfail(strict=True, reason="stiff closed loop (controller poles far from the plant's): our norm "
+                                       "and AB13DD's differ by 0.35 %; numerical trust of freqresp/hinf_norm "
+                                       "on stiff systems is an open issue")
+def test_near_axis_closed_loop_norm_agrees_with_slycot():
+    from pathlib import Path
+    data = np.load(Path(__file__).parent / "data" / "near_axis_plant.npz")
+    P = ss(data["A"], data["B"], data["C"], data["D"])
+    try:
+        res = hinfsyn(P, 2, 2, backoff=0.1, max_backoff=0.1)
+    except SolverError:
+        pytest.skip("this solver release cannot build the controller")
+    assert res.closed_loop_norm_slycot == pytest.approx(res.closed_loop_norm, rel=1e-4)
