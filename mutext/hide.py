@@ -345,7 +345,7 @@ def _case_rotor(path, seed, kind, noise, rng):
                 and el.nominal("di") == 0.0]
     n = eng.layout.n_nodes
     M, _, K, _ = eng.matrices()
-    rotor_mass = float(np.trace(M[0::4, 0::4]))
+    rotor_mass = float(np.sum(M[0::4, 0::4]))     # consistent mass: the whole x-x block
 
     def ext_model(extra_text):
         return loads_model(text.rstrip("\n") + "\n\n" + extra_text, source=f"{path} (hidden effect)",
