@@ -745,6 +745,7 @@ class Diagnosis:
     extended_model_text: str | None
     seconds: float
     notes: list = field(default_factory=list)
+    n_residuals: int = 0          # real residuals of the fit (2 per complex point)
     extended_model: str | None = None
     mbi: dict | None = None
 
@@ -761,11 +762,17 @@ class Diagnosis:
             "resonances": [r.as_dict() for r in self.resonances],
             "summary": self.summary,
             "threshold_delta_chi2": self.threshold, "alpha": self.alpha, "n_hypotheses": self.n_hypotheses,
+            "n_residuals": self.n_residuals,
             "extended_model": self.extended_model,
             "mbi": self.mbi,
             "notes": self.notes,
             "seconds": self.seconds,
         }
+
+    def misfit_left(self, finding: Finding) -> float:
+        """The misfit after ``finding``, in units of what noise alone leaves (about 1 for the right model)."""
+        none = next(f for f in self.findings if f.kind == "none")
+        return (none.score - finding.delta_chi2) / max(self.n_residuals, 1)
 
     def report(self) -> str:
         """Plain-text report (what the command prints)."""
@@ -791,14 +798,16 @@ class Diagnosis:
             out.append("")
         out += [f"  {s}" for s in self.summary] + [""]
         out.append(f"hypotheses tested: {self.n_hypotheses} (accept if delta chi2 > {self.threshold:.1f}, "
-                   f"false-alarm rate {100 * self.alpha:g} %)")
-        out.append(f"  {'rank':<4} {'kind':<12} {'station':>7} {'element':<14} {'size':>24} {'delta chi2':>11}")
+                   f"false-alarm rate {100 * self.alpha:g} %; misfit left: after the hypothesis, in units of "
+                   f"the noise's, about 1 when right)")
+        out.append(f"  {'rank':<4} {'kind':<12} {'station':>7} {'element':<14} {'size':>24} {'delta chi2':>11} "
+                   f"{'misfit left':>11}")
         for k, f in enumerate(self.findings[:8], start=1):
             size = "-" if f.kind == "none" else (f"x{f.value:.4g}" if f.kind.endswith("gain")
                                                  else f"{f.value:+.4g} {f.unit}")
             sd = "" if f.kind == "none" else f" +/- {f.std:.2g}"
             out.append(f"  {k:<4} {f.kind:<12} {str(f.station or '-'):>7} {str(f.element or '-'):<14} "
-                       f"{size + sd:>24} {f.delta_chi2:>11.1f}")
+                       f"{size + sd:>24} {f.delta_chi2:>11.1f} {self.misfit_left(f):>11.3g}")
         out.append("")
         out.append(f"verdict: {self.verdict.sentence()}")
         if self.ambiguous_with:
@@ -1253,7 +1262,7 @@ def diagnose(model, frfs, validate=None, *, alpha: float = 0.01, refit: int = 3,
                                            "validate"))
     result = Diagnosis(eng.name, path, noise, findings, verdict, ambiguous, sensor, err_before, err_after, gain,
                        held_desc, comps, rows, summary, threshold, alpha, nh, text,
-                       time.perf_counter() - t0, notes)
+                       time.perf_counter() - t0, notes, N)
     if mbi and verdict is not none:
         tell("model-based identification at the finding (D-K iteration)", 0.97)
         try:

@@ -325,13 +325,23 @@ def mbi_figure(result, true_systems, Du=None, title=None):
     return fig
 
 
+def _save(fig, outdir, name) -> str:
+    """Save ``fig`` as ``outdir/name`` (PNG, tight layout), close it and return the path."""
+    fig.tight_layout()
+    path = os.path.join(outdir, name)
+    fig.savefig(path, dpi=110)
+    _plt().close(fig)
+    return path
+
+
 def diagnosis_figures(result, outdir) -> list[str]:
     """Figures of a :class:`mutext.diagnose.Diagnosis` saved as PNG in ``outdir``; returns the paths.
 
     ``overlay.png``: magnitude and phase of data, engineering model and extended
     model for each channel; ``residual.png``: the model/data log-magnitude
     ratio over frequency before and after; ``ranking.png``: the improvement
-    of the fit (delta chi2) of the best hypotheses against the acceptance threshold.
+    left after each of the best hypotheses, in units of the misfit noise alone leaves (the right
+    hypothesis brings it to about 1).
     """
     plt = _plt()
     os.makedirs(outdir, exist_ok=True)
@@ -359,11 +369,7 @@ def diagnosis_figures(result, outdir) -> list[str]:
             ax.set_ylabel("|H| [SI]")
             axp.set_ylabel("phase [deg]")
             ax.legend(fontsize=7)
-    fig.tight_layout()
-    p = os.path.join(outdir, "overlay.png")
-    fig.savefig(p, dpi=110)
-    plt.close(fig)
-    paths.append(p)
+    paths.append(_save(fig, outdir, "overlay.png"))
 
     fig, ax = plt.subplots(figsize=(7, 3.6))
     for k, c in enumerate(chans):
@@ -375,25 +381,19 @@ def diagnosis_figures(result, outdir) -> list[str]:
     ax.set_xlabel("frequency [Hz]")
     ax.set_ylabel("model / measured [dB]")
     ax.legend(fontsize=7, ncol=2)
-    fig.tight_layout()
-    p = os.path.join(outdir, "residual.png")
-    fig.savefig(p, dpi=110)
-    plt.close(fig)
-    paths.append(p)
+    paths.append(_save(fig, outdir, "residual.png"))
 
     top = [f for f in result.findings if f.kind != "none"][:10]
-    fig, ax = plt.subplots(figsize=(7, 0.35 * len(top) + 1.2))
+    fig, ax = plt.subplots(figsize=(7, 0.35 * len(top) + 1.4))
     labels = [f"{f.kind} @ {f.station} ({f.element})" for f in top][::-1]
-    vals = [max(f.delta_chi2, 1e-1) for f in top][::-1]
+    vals = [max(result.misfit_left(f), 1e-3) for f in top][::-1]
     ax.barh(labels, vals, color=["C0" if f.significant else "0.6" for f in top][::-1])
-    ax.axvline(result.threshold, color="C3", lw=1, label=f"threshold {result.threshold:.1f}")
+    ax.axvline(1.0, color="C3", lw=1, label="noise alone")
     ax.set_xscale("log")
-    ax.set_xlabel("improvement of the fit, delta chi2")
+    ax.set_xlabel("misfit left after the hypothesis / misfit of the noise alone")
+    ax.set_title(f"{result.n_hypotheses} hypotheses; before any: "
+                 f"{result.misfit_left(next(f for f in result.findings if f.kind == 'none')):.3g}", fontsize=9)
     ax.tick_params(axis="y", labelsize=7)
     ax.legend(fontsize=7)
-    fig.tight_layout()
-    p = os.path.join(outdir, "ranking.png")
-    fig.savefig(p, dpi=110)
-    plt.close(fig)
-    paths.append(p)
+    paths.append(_save(fig, outdir, "ranking.png"))
     return paths

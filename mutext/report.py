@@ -65,6 +65,7 @@ def _html(r: Diagnosis, figs) -> str:
         f"<tr><td>{k}</td><td>{e(f.kind)}</td><td>{f.station or '-'}</td><td>{e(str(f.element or '-'))}</td>"
         f"<td>{'' if f.kind == 'none' else f'{f.value:.5g} {e(f.unit)}'}</td>"
         f"<td>{'' if f.kind == 'none' else f'{f.std:.2g}'}</td><td>{f.delta_chi2:.1f}</td>"
+        f"<td>{r.misfit_left(f):.3g}</td>"
         f"<td>{'yes' if f.significant else ''}</td></tr>"
         for k, f in enumerate(r.findings[:15], start=1))
     res = "".join(
@@ -95,7 +96,7 @@ table{{border-collapse:collapse}} tr:nth-child(even){{background:#f3f3f3}}</styl
 <h2>Hypotheses ({r.n_hypotheses} tested; accepted when delta chi2 &gt; {r.threshold:.1f},
 false-alarm rate {100 * r.alpha:g} %)</h2>
 <table><tr><th>rank</th><th>kind</th><th>station</th><th>element</th><th>size</th><th>std</th>
-<th>delta chi2</th><th>significant</th></tr>{rows}</table>
+<th>delta chi2</th><th>misfit left / noise</th><th>significant</th></tr>{rows}</table>
 <h2>Gain on held-out data</h2><p>{e(r.held_out)}</p>
 <table><tr><th></th><th>rms complex error</th><th>rms log-magnitude error</th></tr>
 <tr><td>engineering model</td><td>{100 * r.error_before['rel']:.3g} %</td><td>{r.error_before['db']:.3g} dB</td></tr>
