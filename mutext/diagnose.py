@@ -674,6 +674,8 @@ class Finding:
             return "no effect beyond the noise"
         if self.unit == "1" and self.kind.endswith("gain"):
             return f"{self.description}: x{self.value:.4g} +/- {self.std:.2g}"
+        if self.kind == "crack":
+            return f"{self.description}: depth ratio a/D = {self.value:.4g} +/- {self.std:.2g}"
         return f"{self.description}: {self.value:+.4g} +/- {self.std:.2g} {self.unit}"
 
 
@@ -804,6 +806,7 @@ class Diagnosis:
                    f"{'misfit left':>11}")
         for k, f in enumerate(self.findings[:8], start=1):
             size = "-" if f.kind == "none" else (f"x{f.value:.4g}" if f.kind.endswith("gain")
+                                                 else f"a/D {f.value:.4g}" if f.kind == "crack"
                                                  else f"{f.value:+.4g} {f.unit}")
             sd = "" if f.kind == "none" else f" +/- {f.std:.2g}"
             out.append(f"  {k:<4} {f.kind:<12} {str(f.station or '-'):>7} {str(f.element or '-'):<14} "
@@ -1221,7 +1224,7 @@ def diagnose(model, frfs, validate=None, *, alpha: float = 0.01, refit: int = 3,
     best = next(f for f in findings if f.kind != "none")
     verdict = best if best.significant else none
     if verdict is none and best.delta_chi2 > 0:
-        notes.append(f"best hypothesis ({best.kind} at {best.station}) improves the fit by delta chi2 = "
+        notes.append(f"best hypothesis ({best.description}) improves the fit by delta chi2 = "
                      f"{best.delta_chi2:.1f}, below the threshold {threshold:.1f}")
     ambiguous, sensor = [], None
     if verdict is not none:

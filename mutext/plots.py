@@ -372,10 +372,12 @@ def diagnosis_figures(result, outdir) -> list[str]:
     paths.append(_save(fig, outdir, "overlay.png"))
 
     fig, ax = plt.subplots(figsize=(7, 3.6))
+    colors = plt.cm.tab20(np.linspace(0, 1, max(len(chans), 2)))
     for k, c in enumerate(chans):
-        ax.plot(c.freq_hz, _db(c.before) - _db(c.measured), "-", color=f"C{k}", lw=1, label=f"{c.label} before")
+        tag = f"{c.label} ({c.role})"
+        ax.plot(c.freq_hz, _db(c.before) - _db(c.measured), "-", color=colors[k], lw=1, label=f"{tag} before")
         if c.after is not None:
-            ax.plot(c.freq_hz, _db(c.after) - _db(c.measured), ":", color=f"C{k}", lw=1, label=f"{c.label} after")
+            ax.plot(c.freq_hz, _db(c.after) - _db(c.measured), ":", color=colors[k], lw=1, label=f"{tag} after")
     noise_db = 20 * np.log10(1 + result.noise)
     ax.axhspan(-2 * noise_db, 2 * noise_db, color="0.85", label="2 x noise")
     ax.set_xlabel("frequency [Hz]")
