@@ -16,6 +16,9 @@ dk
     D-K iteration (mu-synthesis) with rational D-scale fits.
 mbi
     Model-based identification: the unmodeled dynamics as a mu-controller.
+response
+    One frequency-response type (a channel with its stations, directions,
+    port names and units) for measured and modelled data, and the sweep grid.
 frfit
     Stable rational models of measured frequency responses (vector fitting).
 rig

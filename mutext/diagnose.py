@@ -125,7 +125,7 @@ import math
 import os
 import re
 import time
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from typing import Callable
 
 import numpy as np
@@ -1053,8 +1053,8 @@ def diagnose(model, frfs, validate=None, *, alpha: float = 0.01, refit: int = 3,
         (A path is needed to write the extended model next to it.)
     frfs : sequence of FRF or paths
         Measured channels used for the fit.  Stations as numbered in the model
-        file (masses 1..n of a chain); directions from ``input_direction`` /
-        ``output_direction`` metadata (default x).
+        file (masses 1..n of a chain); directions ``input_direction`` /
+        ``output_direction`` (default x).
     validate : sequence of FRF or paths, optional
         Channels held out of the fit, on which the gain is measured.  Default:
         every :data:`HOLDOUT_EVERY`-th frequency of each fitted channel.
@@ -1351,8 +1351,7 @@ def _refit(f: Finding, model_text, path, eng, fit: _Data, s2, N, rss0, threshold
     name = h.parameter
     lo = 1e-9 * h.scale if h.added else h.nominal + h.lower
     hi = h.upper if h.added else h.nominal + h.upper
-    frfs = [FRF(fs, m, input_station=c.frf.input_station, output_station=c.frf.output_station,
-                input_quantity=c.frf.input_quantity, speed_hz=c.frf.speed_hz, metadata=dict(c.frf.metadata))
+    frfs = [replace(c.frf, freq_hz=fs, response=m, metadata=dict(c.frf.metadata))
             for c, fs, m in zip(fit.chans, fit.freq_hz, fit.meas)]
     x0 = min(max(float(ext.values()[ext.parameter_names.index(name)]), lo), hi)
     res = tune(ext, frfs, [name], bounds={name: (lo, hi)}, start={name: x0}, max_iter=60)

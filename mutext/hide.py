@@ -278,9 +278,9 @@ def _case_lumped(path, seed, kind, noise, rng):
 
 
 def _frf(H, f_hz, s_in, s_out, noise, rng, quantity, speed_hz=None, direction=None):
-    meta = {"output_direction": direction} if direction else None
     return measure(lambda w, H=H: H, 0, 0, f_hz, noise=Noise(relative=noise), rng=rng, input_station=s_in,
-                   output_station=s_out, input_quantity=quantity, speed_hz=speed_hz, metadata=meta)
+                   output_station=s_out, input_quantity=quantity, speed_hz=speed_hz,
+                   output_direction=direction or "x")
 
 
 def _detectable(resp, base, size, limit, noise, gain=False, tries=12):
@@ -512,7 +512,7 @@ def _write(case: HiddenCase, path, doc, out: Path):
     files = {"model": str(model_out), "measured": [], "validate": []}
     for role, frfs in (("measured", case.measured), ("validate", case.validate)):
         for frf in frfs:
-            d = frf.metadata.get("output_direction", "x")
+            d = frf.output_direction
             name = f"in{frf.input_station}_out{frf.output_station}{'' if d == 'x' else d}.csv"
             p = write_frf(out / role / name, frf, output_unit="um" if frf.input_quantity == "current" else "m")
             files[role].append(str(p))

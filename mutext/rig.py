@@ -25,7 +25,9 @@ File format
   ``input_unit`` (``N`` for a force, ``A`` for a current),
   ``output_station`` (int), ``output_quantity`` (``displacement``),
   ``output_unit`` (``m``, ``mm``, ``um`` or ``in``).  Optional:
-  ``speed_hz`` (float, running speed).  Any other ``# key: value`` is kept
+  ``speed_hz`` (float, running speed), ``input_direction`` and
+  ``output_direction`` (``x`` or ``y``, the plane of a rotor; default ``x``),
+  ``input_name`` and ``output_name`` (the model's port names).  Any other ``# key: value`` is kept
   as metadata (strings).  Keys are case-sensitive and may appear once.
 * Then the CSV header line ``freq_hz,re,im`` and one row per frequency:
   frequency in Hz (positive, strictly increasing) and the real and
@@ -57,13 +59,14 @@ from __future__ import annotations
 import glob as _glob
 import math
 import os
-from dataclasses import dataclass, field, replace
+from dataclasses import dataclass
 from pathlib import Path
 from typing import Mapping, Sequence
 
 import numpy as np
 
 from .errors import ModelError
+from .response import DIRECTIONS, FRF, INPUT_UNITS, OUTPUT_UNITS, sweep_frequencies
 
 __all__ = [
     "FRF", "FRFFileError", "Noise", "read_frf", "write_frf", "read_frfs", "measure",
@@ -73,14 +76,6 @@ __all__ = [
 
 #: CSV header line that separates the ``#`` header from the data.
 CSV_HEADER = "freq_hz,re,im"
-
-#: Allowed input quantities and their unit (the SI unit; factor to SI is 1).
-INPUT_UNITS: dict[str, dict[str, float]] = {"force": {"N": 1.0}, "current": {"A": 1.0}}
-
-#: Allowed output quantities and units, with the factor that converts to metres.
-OUTPUT_UNITS: dict[str, dict[str, float]] = {
-    "displacement": {"m": 1.0, "mm": 1e-3, "um": 1e-6, "in": 0.0254},
-}
 
 #: Thesis sine sweep: start, stop, step [Hz] ([Mad]_ sec. 4.3).
 THESIS_SWEEP_HZ = (20.0, 1000.0, 0.5)
@@ -93,7 +88,8 @@ THESIS_SPEED_HZ = 10.0
 
 _REQUIRED = ("input_station", "input_quantity", "input_unit",
              "output_station", "output_quantity", "output_unit")
-_RESERVED = _REQUIRED + ("speed_hz",)
+_OPTIONAL = ("speed_hz", "input_direction", "output_direction", "input_name", "output_name")
+_RESERVED = _REQUIRED + _OPTIONAL
 
 
 class FRFFileError(ModelError):
@@ -116,100 +112,6 @@ class FRFFileError(ModelError):
         where = self.path if line is None else f"{self.path}, line {line}"
         what = f" [{field}]" if field else ""
         super().__init__(f"{where}{what}: {problem}")
-
-
-@dataclass
-class FRF:
-    r"""One measured or simulated frequency-response channel, in SI units.
-
-    Attributes
-    ----------
-    freq_hz : ndarray, shape (n,)
-        Frequencies [Hz], positive and strictly increasing.
-    response : ndarray of complex, shape (n,)
-        :math:`G(j\omega)` in m/N (force input) or m/A (current input).
-    input_station, output_station : int or None
-        Station numbers (as in the rotor station table).  Required to write
-        a file.
-    input_quantity : {"force", "current"}
-    output_quantity : {"displacement"}
-    speed_hz : float or None
-        Running speed during the measurement [Hz].
-    metadata : dict of str -> str
-        Any other header entries.
-    source : pathlib.Path or None
-        File the FRF was read from.
-    """
-    freq_hz: np.ndarray
-    response: np.ndarray
-    input_station: int | None = None
-    output_station: int | None = None
-    input_quantity: str = "force"
-    output_quantity: str = "displacement"
-    speed_hz: float | None = None
-    metadata: dict = field(default_factory=dict)
-    source: Path | None = None
-
-    def __post_init__(self):
-        self.freq_hz = np.asarray(self.freq_hz, dtype=float).ravel()
-        self.response = np.asarray(self.response, dtype=complex).ravel()
-        if self.freq_hz.shape != self.response.shape:
-            raise ModelError(f"FRF: {self.freq_hz.size} frequencies but {self.response.size} "
-                             f"response values")
-        if self.freq_hz.size == 0:
-            raise ModelError("FRF: no frequencies")
-        if not np.all(np.isfinite(self.freq_hz)) or np.any(self.freq_hz <= 0):
-            raise ModelError("FRF: frequencies must be finite and positive [Hz]")
-        if np.any(np.diff(self.freq_hz) <= 0):
-            k = int(np.argmax(np.diff(self.freq_hz) <= 0))
-            raise ModelError(f"FRF: frequencies must be strictly increasing; "
-                             f"{self.freq_hz[k + 1]} Hz follows {self.freq_hz[k]} Hz")
-        if not np.all(np.isfinite(self.response)):
-            k = int(np.argmax(~np.isfinite(self.response)))
-            raise ModelError(f"FRF: non-finite response at {self.freq_hz[k]} Hz")
-        if self.input_quantity not in INPUT_UNITS:
-            raise ModelError(f"FRF: input_quantity must be one of {sorted(INPUT_UNITS)}, "
-                             f"got {self.input_quantity!r}")
-        if self.output_quantity not in OUTPUT_UNITS:
-            raise ModelError(f"FRF: output_quantity must be one of {sorted(OUTPUT_UNITS)}, "
-                             f"got {self.output_quantity!r}")
-
-    @property
-    def omega(self) -> np.ndarray:
-        """Frequencies in rad/s."""
-        return 2.0 * np.pi * self.freq_hz
-
-    @property
-    def input_unit(self) -> str:
-        """SI unit of the input (``N`` or ``A``)."""
-        return next(iter(INPUT_UNITS[self.input_quantity]))
-
-    @property
-    def output_unit(self) -> str:
-        """SI unit of the output (``m``)."""
-        return "m"
-
-    @property
-    def unit(self) -> str:
-        """Unit of :attr:`response`, e.g. ``m/A``."""
-        return f"{self.output_unit}/{self.input_unit}"
-
-    def response_in(self, output_unit: str) -> np.ndarray:
-        """The response expressed in ``output_unit`` per SI input unit (e.g. ``um`` -> um/A)."""
-        units = OUTPUT_UNITS[self.output_quantity]
-        if output_unit not in units:
-            raise ModelError(f"unknown {self.output_quantity} unit {output_unit!r}; "
-                             f"allowed: {', '.join(units)}")
-        return self.response / units[output_unit]
-
-    def band(self, fmin: float, fmax: float) -> "FRF":
-        """The part of the FRF with ``fmin <= f <= fmax`` [Hz] (e.g. the 20-225 Hz analysis band)."""
-        keep = (self.freq_hz >= fmin) & (self.freq_hz <= fmax)
-        if not np.any(keep):
-            raise ModelError(f"FRF has no frequency in [{fmin}, {fmax}] Hz "
-                             f"(it covers {self.freq_hz[0]}-{self.freq_hz[-1]} Hz)")
-        return replace(self, freq_hz=self.freq_hz[keep], response=self.response[keep],
-                       metadata=dict(self.metadata))
 
 
 # ----------------------------------------------------------------------------
@@ -331,6 +233,13 @@ def read_frf(path) -> FRF:
     speed = None
     if "speed_hz" in header:
         speed = _parse_float(header["speed_hz"][0], path, header["speed_hz"][1], "speed_hz")
+    dirs = {}
+    for key in ("input_direction", "output_direction"):
+        v, ln = header.get(key, ("x", None))
+        if v not in DIRECTIONS:
+            raise FRFFileError(path, ln, key, f"unknown direction {v!r}; allowed: {', '.join(DIRECTIONS)}")
+        dirs[key] = v
+    port_names = {key: header[key][0] for key in ("input_name", "output_name") if key in header}
     # --- data rows
     freqs, vals = [], []
     names = CSV_HEADER.split(",")
@@ -363,7 +272,7 @@ def read_frf(path) -> FRF:
     meta["file_input_unit"] = in_u
     return FRF(freq_hz=np.array([f for f, _ in freqs]), response=np.array(vals) * scale,
                input_station=in_station, output_station=out_station, input_quantity=in_q,
-               output_quantity=out_q, speed_hz=speed, metadata=meta, source=path)
+               output_quantity=out_q, speed_hz=speed, metadata=meta, source=path, **dirs, **port_names)
 
 
 def write_frf(path, frf: FRF, *, output_unit: str = "m") -> Path:
@@ -403,6 +312,15 @@ def write_frf(path, frf: FRF, *, output_unit: str = "m") -> Path:
     ]
     if frf.speed_hz is not None:
         lines.append(f"# speed_hz: {float(frf.speed_hz)!r}")
+    for key in ("input_direction", "output_direction"):
+        if getattr(frf, key) != "x":
+            lines.append(f"# {key}: {getattr(frf, key)}")
+    for key in ("input_name", "output_name"):
+        v = getattr(frf, key)
+        if v is not None:
+            if not isinstance(v, str) or not v.strip() or any(c in v for c in "\r\n"):
+                raise ModelError(f"write_frf {path}: {key} {v!r} cannot be written on one header line")
+            lines.append(f"# {key}: {v.strip()}")
     for k, v in frf.metadata.items():
         if k in ("file_output_unit", "file_input_unit") or k in _RESERVED:
             continue
@@ -450,24 +368,6 @@ def read_frfs(paths_or_glob) -> list[FRF]:
 # ----------------------------------------------------------------------------
 # virtual rig
 # ----------------------------------------------------------------------------
-
-def sweep_frequencies(start: float = 20.0, stop: float = 225.0, step: float = 0.5) -> np.ndarray:
-    """Linear sine-sweep frequencies [Hz]: ``start, start+step, ...`` up to ``stop`` inclusive.
-
-    The defaults give the thesis analysis band (20-225 Hz in 0.5 Hz steps,
-    411 points); ``sweep_frequencies(*THESIS_SWEEP_HZ)`` the full 20-1000 Hz
-    sweep.  The grid is computed as ``start + k*step`` (no accumulated
-    rounding); ``stop`` is included when it lies on the grid to 1e-9 steps.
-    """
-    start, stop, step = float(start), float(stop), float(step)
-    if not (math.isfinite(start) and math.isfinite(stop) and math.isfinite(step)):
-        raise ModelError("sweep_frequencies: start, stop and step must be finite")
-    if start <= 0 or step <= 0 or stop < start:
-        raise ModelError(f"sweep_frequencies: need 0 < start <= stop and step > 0 [Hz], got "
-                         f"start={start}, stop={stop}, step={step}")
-    n = int(math.floor((stop - start) / step + 1e-9)) + 1
-    return start + step * np.arange(n)
-
 
 @dataclass(frozen=True)
 class Noise:
@@ -566,7 +466,8 @@ def _response(system, input, output, omega) -> np.ndarray:
 def measure(system, input=0, output=0, freq_hz=None, *, noise=None, rng=None,
             input_station: int | None = None, output_station: int | None = None,
             input_quantity: str = "force", output_quantity: str = "displacement",
-            speed_hz: float | None = None, metadata: Mapping[str, str] | None = None) -> FRF:
+            speed_hz: float | None = None, metadata: Mapping[str, str] | None = None,
+            input_direction: str = "x", output_direction: str = "x") -> FRF:
     r"""Virtual sine-sweep measurement of one channel of a model.
 
     Parameters
@@ -590,6 +491,8 @@ def measure(system, input=0, output=0, freq_hz=None, *, noise=None, rng=None,
     output_quantity : {"displacement"}
     speed_hz : float, optional
         Running speed stored in the FRF [Hz].
+    input_direction, output_direction : {"x", "y"}
+        Directions stored in the FRF (the plane of a rotor).
     metadata : mapping, optional
         Extra metadata; ``noise_relative`` and ``noise_floor`` are added when
         noise is applied.
@@ -609,6 +512,11 @@ def measure(system, input=0, output=0, freq_hz=None, *, noise=None, rng=None,
         G = G + sigma * (gen.standard_normal(G.size) + 1j * gen.standard_normal(G.size)) / np.sqrt(2.0)
         meta["noise_relative"] = repr(nz.relative)
         meta["noise_floor"] = repr(nz.floor)
+    names = {}
+    if isinstance(input, str):
+        names["input_name"] = input
+    if isinstance(output, str):
+        names["output_name"] = output
     return FRF(freq_hz=f, response=G, input_station=input_station, output_station=output_station,
                input_quantity=input_quantity, output_quantity=output_quantity, speed_hz=speed_hz,
-               metadata=meta)
+               metadata=meta, input_direction=input_direction, output_direction=output_direction, **names)

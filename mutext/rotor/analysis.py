@@ -52,6 +52,7 @@ import scipy.linalg as sla
 
 from ..errors import ModelError
 from ..lti import blas_single_thread, mck_to_ss
+from ..response import FRFMatrix
 
 __all__ = ["Modes", "FRF", "Campbell", "modes", "natural_frequencies", "campbell", "frf",
            "state_space", "whirl_index", "blas_single_thread"]
@@ -105,25 +106,8 @@ class Modes:
         return out
 
 
-@dataclass
-class FRF:
-    """Frequency response ``H[i, j, k]``: output ``i`` per unit input ``j`` at ``freqs_hz[k]``.
-
-    Units: output unit (m or rad) per input unit (N, N m or A).
-    """
-    freqs_hz: np.ndarray
-    H: np.ndarray
-    inputs: list
-    outputs: list
-    speed: float
-
-    def __call__(self, output: str, input: str) -> np.ndarray:
-        """The response from ``input`` to ``output`` (complex, one per frequency)."""
-        try:
-            return self.H[self.outputs.index(output), self.inputs.index(input)]
-        except ValueError:
-            raise ModelError(f"FRF has inputs {self.inputs} and outputs {self.outputs}; "
-                             f"asked for {input} -> {output}") from None
+#: A model's responses between named ports (one home for frequency responses: :mod:`mutext.response`).
+FRF = FRFMatrix
 
 
 @dataclass
@@ -288,7 +272,21 @@ def _frf(model, f, ins, outs, speed, v) -> FRF:
         Z = K[None] - wk * wk * M[None] + 1j * wk * D[None]       # dynamic stiffness, batched
         X = np.linalg.solve(Z, np.broadcast_to(B, (wk.shape[0],) + B.shape))
         H[:, :, k0:k0 + chunk] = np.moveaxis(Cy[None] @ X, 0, -1)
-    return FRF(f, H, ins, outs, speed)
+    return FRFMatrix(f, H, ins, outs, speed, _port_info(model, ins, outs))
+
+
+def _port_info(model, ins, outs) -> dict:
+    """Port name -> (station, direction, quantity) for :meth:`FRFMatrix.channel`."""
+    lab = {"u": "x", "v": "y", "x": "x"}
+    info = {}
+    for q in model.inputs:
+        if q.name in ins:
+            qty = "current" if q.gain is not None else ("force" if q.direction in lab else None)
+            info[q.name] = (q.node, lab.get(q.direction, q.direction), qty)
+    for q in model.outputs:
+        if q.name in outs:
+            info[q.name] = (q.node, lab.get(q.direction, q.direction), "displacement" if q.direction in lab else None)
+    return info
 
 
 def state_space(model, *, inputs: Sequence[str] | None = None, outputs: Sequence[str] | None = None,

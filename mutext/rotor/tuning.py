@@ -228,7 +228,7 @@ def _station(model, frf, which, k):
 
 
 def _direction(model, frf, which, k):
-    d = str(frf.metadata.get(f"{which}_direction", "x"))
+    d = getattr(frf, f"{which}_direction", "x")
     try:
         return model.layout.label(d)
     except ModelError as exc:
@@ -524,7 +524,7 @@ def model_response(model, frf, values=None, freq_hz=None) -> np.ndarray:
     model : Structure, Rotor or path
     frf : mutext.rig.FRF
         Gives the channel (input/output station and quantity, speed, and
-        optional ``input_direction``/``output_direction`` metadata, default x).
+        ``input_direction``/``output_direction``, default x).
     values : mapping or array, optional
         Parameter values (default nominal).
     freq_hz : array_like, optional
@@ -691,7 +691,7 @@ def tune(model, frfs, parameters, bounds: Mapping | None = None, *, start: Mappi
         ``current`` input needs an exciter at that station, a ``force`` input
         is a unit force on the station's x DOF).  ``speed_hz`` of an FRF sets
         the spin speed of its channel (default: the model's speed).
-        ``metadata['input_direction']`` / ``['output_direction']`` = ``"y"``
+        ``input_direction`` / ``output_direction`` = ``"y"``
         select the y direction.
     parameters : sequence
         Names of the parameters to fit (``model.parameter_names``, e.g.
