@@ -46,6 +46,9 @@ def solve(params=two_mass.THESIS):
         "closed_loop_hinf_slycot": res.closed_loop_norm_slycot,
         "controller_order": res.controller_order,
         "controller_poles": [[float(p.real), float(p.imag)] for p in res.controller_poles],
+        "controller_rhp_poles": [[float(p.real), float(p.imag)] for p in res.controller_rhp_poles],
+        "closed_loop_stable": bool(res.stable),
+        "max_closed_loop_real_part": float(res.max_closed_loop_real_part),
         "seconds": seconds,
     }
 
@@ -62,13 +65,15 @@ def run(args) -> int:
     res = out["result"]
     if args.json:
         from ..cli import print_json
-        print_json({k: out[k] for k in ("gamma", "gamma_slycot", "closed_loop_hinf", "controller_poles",
-                                        "seconds", "controller_order", "gamma_thesis")})
+        print_json({k: out[k] for k in ("gamma", "gamma_slycot", "closed_loop_hinf", "closed_loop_hinf_slycot",
+                                        "closed_loop_stable", "max_closed_loop_real_part", "controller_poles",
+                                        "controller_rhp_poles", "seconds", "controller_order", "gamma_thesis")})
     else:
         print(res.summary())
         print(f"slycot hinfsyn (Riccati) gamma   = {out['gamma_slycot']:.6f}  "
               f"(relative difference {abs(out['gamma'] - out['gamma_slycot']) / out['gamma_slycot']:.1e})")
-        print(f"thesis (MATLAB) reported gamma   = {two_mass.THESIS_GAMMA}")
+        print(f"thesis (MATLAB) reported gamma   = {two_mass.THESIS_GAMMA}  (why it differs: the book, chapter "
+              f"'H-infinity control', section '0.9671 or 1.0069?')")
         print("controller poles: " + ", ".join(f"{p:.4g}" for p in res.controller_poles))
         print(f"time: {out['seconds']:.2f} s")
     if args.plots:

@@ -1,0 +1,31 @@
+"""What a new user meets in the demos: help, honest output with their own data, complete JSON."""
+import json
+
+import pytest
+
+from mutext.cli import main
+from mutext.rig import FRF, write_frf
+
+
+def test_demo_help_is_the_demos_own(capsys):
+    with pytest.raises(SystemExit) as exc:
+        main(["demo", "diagnose", "--help"])
+    assert exc.value.code == 0
+    out = capsys.readouterr().out
+    assert "--example" in out and "--seed" in out
+
+
+def test_three_mass_frf_must_be_the_f1_x1_channel(tmp_path, capsys):
+    path = write_frf(tmp_path / "x3.csv", FRF([0.5, 1.0, 2.0, 3.0], [1e-3, 2e-3, 1e-3, 5e-4], input_station=1,
+                                              output_station=3))
+    assert main(["demo", "three-mass", "--frf", str(path), "--quiet"]) == 1
+    err = capsys.readouterr().err
+    assert "f1 -> x1" in err and "station 3" in err
+
+
+def test_two_mass_hinf_json_reports_the_checks(capsys):
+    assert main(["demo", "two-mass-hinf", "--json"]) == 0
+    d = json.loads(capsys.readouterr().out)
+    assert d["closed_loop_stable"] is True
+    assert len(d["controller_rhp_poles"]) == 2
+    assert d["closed_loop_hinf_slycot"] == pytest.approx(d["closed_loop_hinf"], rel=1e-4)
