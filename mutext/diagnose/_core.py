@@ -1,0 +1,307 @@
+"""The entry point :func:`diagnose`."""
+from __future__ import annotations
+
+import logging
+import math
+import os
+import time
+from typing import Callable
+
+import numpy as np
+import scipy.stats as sst
+
+from ..errors import ModelError
+from ..frfit import noise_level
+from ..response import FRF
+from ..rig import read_frf
+from ..rotor.model import load_model, loads_model
+from ..rotor.tuning import model_response
+from ._compare import _errors, _model_modes, _resonance_table, _summary
+from ._extend import _refit, extended_model_text, mbi_reading, write_model
+from ._hypotheses import Hypothesis, _gain_hypotheses, hypotheses
+from ._result import ChannelComparison, Diagnosis, Finding
+from ._screen import _Data, _Evaluator, _Receptance, _fit_size, _jacobian_std, _resolve, _rss, _separating_station, _src
+
+log = logging.getLogger("mutext.diagnose")
+
+#: Without validation files, every this many-th frequency of each channel is held out of the fit.
+HOLDOUT_EVERY = 5
+
+def _as_frfs(frfs, what) -> list[FRF]:
+    if frfs is None:
+        return []
+    if isinstance(frfs, (FRF, str, os.PathLike)):
+        frfs = [frfs]
+    out = [f if isinstance(f, FRF) else read_frf(f) for f in frfs]
+    return out
+
+
+def _same_data(a: FRF, b: FRF) -> bool:
+    return (a.freq_hz.shape == b.freq_hz.shape and np.array_equal(a.freq_hz, b.freq_hz)
+            and np.array_equal(a.response, b.response))
+
+
+def diagnose(model, frfs, validate=None, *, alpha: float = 0.01, refit: int = 3, noise: float | None = None,
+             out_dir=None, progress: Callable[[str, float], None] | None = None,
+             only: Callable[[Hypothesis], bool] | None = None, mbi: bool = False) -> Diagnosis:
+    r"""Find what ``model`` gets wrong against measured FRFs, name the cause, extend the model, measure the gain.
+
+    See the module docstring for the method and the statistics.
+
+    Parameters
+    ----------
+    model : str or os.PathLike
+        Model file (TOML, :mod:`mutext.rotor.model`): a lumped chain or a rotor.
+        (A path is needed to write the extended model next to it.)
+    frfs : sequence of FRF or paths
+        Measured channels used for the fit.  Stations as numbered in the model
+        file (masses 1..n of a chain); directions ``input_direction`` /
+        ``output_direction`` (default x).
+    validate : sequence of FRF or paths, optional
+        Channels held out of the fit, on which the gain is measured.  Default:
+        every :data:`HOLDOUT_EVERY`-th frequency of each fitted channel.
+    alpha : float
+        False-alarm rate of the *none* verdict (Bonferroni over the hypotheses).
+    refit : int
+        Number of best hypotheses refitted on the extended model with
+        :func:`mutext.rotor.tuning.tune`.
+    noise : float, optional
+        Relative noise level; default estimated from the data
+        (:func:`mutext.frfit.noise_level`).
+    out_dir : path, optional
+        Write ``model_extended.toml`` there (:func:`write_model`; :func:`mutext.report.write_diagnosis`
+        writes the report and figures too).
+    progress : callable(stage: str, fraction: float), optional
+        Called as the work proceeds (the command line draws a progress line).
+    mbi : bool
+        Also read the top finding the thesis's way (lumped chains): model-based
+        identification (:func:`mutext.mbi.identify`, D-K iteration) with the
+        controller at the finding's mass, K read as mass, damper and spring,
+        compared with the diagnosis (``Diagnosis.mbi``).  Takes 5-60 s more.
+    only : callable(Hypothesis) -> bool, optional
+        Test only the hypotheses it accepts (e.g. a fit told the kind and the
+        location: ``only=lambda h: (h.kind, h.station) == ("mass", 3)``); the
+        Bonferroni threshold counts the hypotheses actually tested.
+
+    Returns
+    -------
+    Diagnosis
+    """
+    t0 = time.perf_counter()
+
+    def tell(stage, frac):
+        log.info("%s (%.0f %%)", stage, 100 * frac)
+        if progress is not None:
+            progress(stage, frac)
+
+    path, eng, model_text, chans, vchans, speed = _inputs(model, frfs, validate, alpha)
+    noise = _noise(chans, noise)
+    s2 = noise ** 2 / 2.0
+    tell("engineering model's receptance", 0.02)
+    allf = np.unique(np.concatenate([c.frf.freq_hz for c in chans + vchans]))    # one grid for all
+    rec = _Receptance(eng, None, speed, 2 * np.pi * allf)
+    fit, held, all_fit, held_desc = _data_sets(rec, allf, chans, vchans)
+
+    # 1. what the simulation gets wrong
+    before = all_fit.H0
+    rows = _resonance_table(chans, before, eng, speed, noise)
+    summary = _summary(rows, chans, before)
+
+    # 2. the hypotheses, screened, the best refitted on the extended model, the verdict
+    hyps = hypotheses(eng) + _gain_hypotheses(eng, chans)
+    if only is not None:
+        hyps = [h for h in hyps if only(h)]
+        if not hyps:
+            raise ModelError("diagnose: no hypothesis passes the 'only' filter")
+    N = 2 * fit.n_points
+    rss0 = _rss(fit.H0, fit.meas)
+    threshold = float(sst.chi2.isf(alpha / len(hyps), 1))
+    findings = _screen_all(hyps, rec, fit, s2, N, rss0, threshold, tell)
+    notes = _refit_best(findings, refit, model_text, path, eng, fit, s2, N, rss0, threshold, tell)
+    none = Finding("none", None, None, 0.0, "", 0.0, rss0 / s2, 0.0, "no effect beyond the noise")
+    findings.sort(key=lambda f: f.score)
+    findings.insert(next((i for i, f in enumerate(findings) if f.score > none.score), len(findings)), none)
+    verdict, ambiguous, sensor = _decide(findings, none, threshold, N, rec, fit, eng, notes)
+
+    # 3. the extended model and its gain on held-out data
+    tell("held-out gain", 0.95)
+    text = extended_model_text(model_text, verdict, eng) if verdict is not none else None
+    after_all, after_held = _after(verdict, text, path, rec, chans, all_fit, held)
+    err_before = _errors(held.H0, held.meas)
+    err_after = _errors(after_held, held.meas)
+    gain = err_before["rel"] / err_after["rel"] if err_after["rel"] > 0 else math.inf
+    comps = [ChannelComparison(c.label, _src(c.frf, k + 1), c.frf.freq_hz, c.frf.response, before[k],
+                               None if after_all is None else after_all[k], "fit") for k, c in enumerate(chans)]
+    comps += [ChannelComparison(c.label, _src(c.frf, k + 1), c.frf.freq_hz, c.frf.response, held.H0[k],
+                                None if verdict is none else after_held[k], "validate")
+              for k, c in enumerate(vchans)]
+    result = Diagnosis(eng.name, path, noise, findings, verdict, ambiguous, sensor, err_before, err_after, gain,
+                       held_desc, comps, rows, summary, threshold, alpha, len(hyps), text,
+                       time.perf_counter() - t0, notes, N)
+    if mbi and verdict is not none:
+        tell("model-based identification at the finding (D-K iteration)", 0.97)
+        try:
+            result.mbi = mbi_reading(model_text, path, verdict, chans[0].frf, chans[0].in_name,
+                                     chans[0].out_name)
+        except ModelError as exc:
+            result.mbi = {"location": None, "reading": f"not run: {exc}", "agrees": None}
+        result.seconds = time.perf_counter() - t0
+    if out_dir is not None:
+        write_model(result, out_dir)
+    tell("done", 1.0)
+    return result
+
+
+def _inputs(model, frfs, validate, alpha):
+    """The model file and the channels, checked: (path, model, text, fit channels, held-out channels, speed)."""
+    if not isinstance(model, (str, os.PathLike)):
+        raise ModelError("diagnose: give the model as a model file path (TOML); the extended model is "
+                         "written from it")
+    path = os.fspath(model)
+    eng = load_model(path)
+    with open(path, encoding="utf-8") as fh:
+        model_text = fh.read()
+    if not 0 < alpha < 1:
+        raise ModelError(f"diagnose: alpha must be in (0, 1), got {alpha}")
+    fit_frfs = _as_frfs(frfs, "data")
+    if not fit_frfs:
+        raise ModelError("diagnose: no measured FRF given")
+    val_frfs = _as_frfs(validate, "validation")
+    for v in val_frfs:
+        for f in fit_frfs:
+            if _same_data(v, f):
+                raise ModelError(f"validation file {_src(v, 0)} holds the same data as the fitted "
+                                 f"{_src(f, 0)}: held-out data must not be used in the fit")
+    chans, _ = _resolve(eng, fit_frfs, "data")
+    vchans, _ = _resolve(eng, val_frfs, "validation") if val_frfs else ([], None)
+    speeds = {c.speed for c in chans + vchans}
+    if len(speeds) > 1:
+        raise ModelError(f"diagnose: the FRFs were measured at different running speeds "
+                         f"({sorted(s / (2 * math.pi) for s in speeds)} Hz); diagnose one speed at a time")
+    speed = speeds.pop()
+    # frequency overlap with the model's modes: at least one model resonance within the data band
+    fmin = min(c.frf.freq_hz[0] for c in chans)
+    fmax = max(c.frf.freq_hz[-1] for c in chans)
+    fmodes, _ = _model_modes(eng, speed)
+    if not np.any((fmodes >= fmin) & (fmodes <= fmax)):
+        raise ModelError(f"diagnose: the data cover {fmin:g}-{fmax:g} Hz but the model has no resonance there "
+                         f"(model resonances: {', '.join(f'{x:.4g}' for x in fmodes[:6])} Hz): check the units of "
+                         f"the frequency column and that the file belongs to this model")
+    return path, eng, model_text, chans, vchans, speed
+
+
+def _noise(chans, noise) -> float:
+    """The relative noise level: given, or estimated from the data alone (points-weighted rms)."""
+    if noise is None:
+        lv = [noise_level(c.frf.freq_hz, c.frf.response) for c in chans]
+        npts = [c.frf.freq_hz.size for c in chans]
+        noise = float(math.sqrt(np.average(np.square(lv), weights=npts)))
+    elif not (isinstance(noise, (int, float)) and math.isfinite(noise) and 0 < noise < 1):
+        raise ModelError(f"diagnose: noise must be a relative level in (0, 1), e.g. 0.01 for 1 %; got {noise!r}")
+    return max(float(noise), 1e-6)
+
+
+def _data_sets(rec, allf, chans, vchans):
+    """(fit, held out, all fitted channels, description of the held-out data)."""
+    def data_for(cs, keep):
+        idx, meas, H0, b, fs = [], [], [], [], []
+        for c, kp in zip(cs, keep):
+            pos = np.searchsorted(allf, c.frf.freq_hz[kp])
+            bb = rec.input_vector(c.in_spec)
+            idx.append(pos)
+            meas.append(c.frf.response[kp])
+            H0.append(rec.R[pos][:, c.out_dof, :] @ bb)
+            b.append(bb)
+            fs.append(c.frf.freq_hz[kp])
+        return _Data(list(cs), idx, meas, H0, b, fs)
+
+    every = [np.arange(c.frf.freq_hz.size) for c in chans]
+    if vchans:
+        fit = data_for(chans, every)
+        held = data_for(vchans, [np.arange(c.frf.freq_hz.size) for c in vchans])
+        desc = f"{len(vchans)} validation channel(s): " + ", ".join(_src(c.frf, k) for k, c in enumerate(vchans, 1))
+    else:
+        out = [k[k % HOLDOUT_EVERY == HOLDOUT_EVERY // 2] for k in every]
+        kept = [k[k % HOLDOUT_EVERY != HOLDOUT_EVERY // 2] for k in every]
+        fit, held = data_for(chans, kept), data_for(chans, out)
+        desc = (f"every {HOLDOUT_EVERY}th frequency of the fitted channels, held out of the fit "
+                f"(no validation files given; neighbouring frequencies are not independent data)")
+    return fit, held, data_for(chans, every), desc
+
+
+def _screen_all(hyps, rec, fit, s2, N, rss0, threshold, tell) -> list:
+    """Every hypothesis fitted exactly through the receptance, ranked by score."""
+    findings = []
+    nh = len(hyps)
+    for k, h in enumerate(hyps):
+        if k % max(1, nh // 20) == 0:
+            tell(f"screening hypotheses {k + 1}/{nh}", 0.05 + 0.6 * k / nh)
+        ev = _Evaluator(rec, fit, h)
+        theta, rss = _fit_size(ev)
+        std = _jacobian_std(ev, theta, s2) if rss < rss0 else math.inf
+        findings.append(_finding(h, theta, std, rss, rss0, s2, N, threshold))
+    findings.sort(key=lambda f: f.score)
+    return findings
+
+
+def _refit_best(findings, refit, model_text, path, eng, fit, s2, N, rss0, threshold, tell) -> list:
+    """Refit the best few on the extended model file itself (with modal damping the damping matrix follows
+    the changed stiffness and mass there, unlike in the screen); returns notes on refits that failed."""
+    notes, n_ref = [], 0
+    for f in findings:
+        if n_ref >= refit:
+            break
+        if f.delta_chi2 <= 0.5 * threshold:      # cannot become significant: no need to refit
+            continue
+        h = f.hypothesis
+        if h.gain is not None or h.parameter is None:
+            continue
+        n_ref += 1
+        tell(f"refitting {f.kind} at {f.station} on the extended model", 0.7 + 0.2 * n_ref / max(refit, 1))
+        try:
+            _refit(f, model_text, path, eng, fit, s2, N, rss0, threshold)
+        except Exception as exc:   # the screen's value stands; say why
+            notes.append(f"refit of {f.kind} at station {f.station} failed ({exc}); the screen's value is shown")
+    return notes
+
+
+def _decide(findings, none, threshold, N, rec, fit, eng, notes):
+    """The verdict (the best significant hypothesis, or none), those it cannot be told from, and the
+    sensor station that would separate them; notes are appended to ``notes``."""
+    best = next(f for f in findings if f.kind != "none")
+    verdict = best if best.significant else none
+    if verdict is none:
+        if best.delta_chi2 > 0:
+            notes.append(f"best hypothesis ({best.description}) improves the fit by delta chi2 = "
+                         f"{best.delta_chi2:.1f}, below the threshold {threshold:.1f}")
+        return verdict, [], None
+    ambiguous = [f for f in findings if f is not verdict and f.kind != "none" and f.significant
+                 and (f.score - verdict.score) < float(sst.chi2.isf(0.05, 1))]
+    sensor = _separating_station(rec, fit, [verdict] + ambiguous, eng) if ambiguous else None
+    left = verdict.score - math.log(N)
+    if left > 2 * N + 6 * math.sqrt(2 * N):
+        notes.append(f"after the best hypothesis the residual is still {math.sqrt(left / N):.2g} "
+                     f"times the noise: part of the misfit lies beyond the hypotheses tested")
+    return verdict, ambiguous, sensor
+
+
+def _after(verdict, text, path, rec, chans, all_fit, held):
+    """Responses of the extended model on the fitted channels and on the held-out data."""
+    if verdict.kind == "none":
+        return None, held.H0
+    if verdict.hypothesis.gain is not None:
+        return (_Evaluator(rec, all_fit, verdict.hypothesis).responses(verdict.value),
+                _Evaluator(rec, held, verdict.hypothesis).responses(verdict.value))
+    # the extended model file itself, loaded as a user would load it
+    ext = loads_model(text, source=f"{path} (extended)", base_dir=os.path.dirname(os.path.abspath(path)))
+    return ([model_response(ext, c.frf) for c in chans],
+            [model_response(ext, c.frf, freq_hz=fs) for c, fs in zip(held.chans, held.freq_hz)])
+
+
+def _finding(h, theta, std, rss, rss0, s2, N, threshold) -> Finding:
+    dchi = (rss0 - rss) / s2
+    new = None
+    if h.gain is None and not h.added:
+        new = h.nominal + theta
+    return Finding(h.kind, h.station, h.element, float(theta), h.unit, float(std), rss / s2 + math.log(N),
+                   float(dchi), h.description, bool(dchi > threshold), False, new, h)

@@ -1,0 +1,298 @@
+"""The exact screen: the engineering model's receptance, and every hypothesis's response and size from it."""
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from ..errors import ModelError
+from ..response import FRF
+from ..rotor.tuning import _Inputs, _resolve_channel
+from ._hypotheses import Hypothesis
+
+@dataclass
+class _Chan:
+    frf: FRF
+    label: str
+    in_spec: tuple
+    in_col: int
+    in_name: str
+    in_station: int
+    out_dof: int
+    out_name: str
+    out_station: int
+    speed: float
+
+
+def _resolve(model, frfs: list, what: str):
+    inputs = _Inputs(model)
+    chans = []
+    for k, frf in enumerate(frfs, start=1):
+        if not isinstance(frf, FRF):
+            raise ModelError(f"{what} #{k}: expected a mutext.rig.FRF, got {type(frf).__name__}")
+        try:
+            col, od, label, speed = _resolve_channel(model, frf, k, inputs)
+        except ModelError as exc:
+            src = f"{frf.source}: " if frf.source else ""
+            raise ModelError(f"{src}{exc}") from None
+        if np.any(frf.response == 0):
+            raise ModelError(f"{_src(frf, k)}: zero response at {frf.freq_hz[np.argmax(frf.response == 0)]:g} Hz "
+                             "(a log-ratio residual needs a nonzero response)")
+        in_name, out_name = _port_names(model, inputs.specs[col], od, label)
+        label = f"{in_name}->{out_name}"
+        chans.append(_Chan(frf, label, inputs.specs[col], col, in_name, int(frf.input_station), od, out_name,
+                           int(frf.output_station), speed))
+    return chans, inputs
+
+
+def _port_names(model, in_spec, out_dof, label):
+    """Names of the model's ports for a channel (the file's stations otherwise)."""
+    in_name, out_name = label.split("->")
+    if in_spec[0] == "port":
+        in_name = model.input_names[in_spec[1]]
+    else:
+        lay = model.layout
+        for q in model.inputs:
+            if q.gain is None and lay.dof(q.node, q.direction) == in_spec[1]:
+                in_name = q.name
+                break
+    if out_dof in model.output_dofs:
+        out_name = model.output_names[model.output_dofs.index(out_dof)]
+    return in_name, out_name
+
+
+def _src(frf, k):
+    return str(frf.source) if frf.source else f"FRF #{k}"
+
+
+
+class _Receptance:
+    """Receptance R = Z^-1 of the engineering model at a set of frequencies, and channel pieces."""
+
+    def __init__(self, model, values, speed, omega, chunk_bytes=64_000_000):
+        M, C, K, G = model.matrices(values)
+        self.B = model.input_matrix(values)
+        self.omega = np.asarray(omega, float)
+        n = M.shape[0]
+        D = C + speed * G
+        R = np.empty((self.omega.size, n, n), complex)
+        chunk = max(1, int(chunk_bytes // (16 * n * n)))
+        for k0 in range(0, self.omega.size, chunk):
+            w = self.omega[k0:k0 + chunk, None, None]
+            Z = K[None] - w * w * M[None] + 1j * w * D[None]
+            R[k0:k0 + chunk] = np.linalg.inv(Z)
+        self.R = R
+        self.M, self.K = M, K
+
+    def input_vector(self, spec) -> np.ndarray:
+        kind, j = spec
+        if kind == "port":
+            return self.B[:, j]
+        b = np.zeros(self.B.shape[0])
+        b[j] = 1.0
+        return b
+
+
+@dataclass
+class _Data:
+    """Stacked channel data for one set of frequencies (fit or held-out)."""
+    chans: list
+    idx: list            # per channel: indices into the receptance frequency grid
+    meas: list           # per channel: measured response at those points
+    H0: list             # per channel: engineering-model response
+    b: list              # per channel: input vector
+    freq_hz: list = None  # per channel: the frequencies [Hz]
+    _cols: dict = None
+
+    @property
+    def n_points(self) -> int:
+        return sum(len(i) for i in self.idx)
+
+    def columns(self, rec, k):
+        """``(R b, R_o:)`` of channel k at its frequencies (computed once, shared by all hypotheses)."""
+        if self._cols is None:
+            self._cols = {}
+        if k not in self._cols:
+            idx = self.idx[k]
+            Ro = rec.R[idx, self.chans[k].out_dof, :]
+            Rb = np.einsum("kij,j->ki", rec.R[idx], self.b[k])
+            self._cols[k] = (Rb, Ro)
+        return self._cols[k]
+
+
+class _Evaluator:
+    """Responses of the channels of a data set under one hypothesis, exactly for any size."""
+
+    def __init__(self, rec: _Receptance, data: _Data, hyp: Hypothesis):
+        self.hyp, self.data = hyp, data
+        self.pieces = []
+        U = hyp.dofs
+        for k, (ch, idx) in enumerate(zip(data.chans, data.idx)):
+            if hyp.gain is not None:
+                self.pieces.append(None)
+                continue
+            Rb, Ro = data.columns(rec, k)
+            y = Rb[:, U]                              # R_U: b   (nf, |U|)
+            z = Ro[:, U]                              # R_oU     (nf, |U|)
+            RUU = rec.R[np.ix_(idx, U, U)]            # (nf, |U|, |U|)
+            w = rec.omega[idx]
+            self.pieces.append((y, z, RUU, w))
+
+    def _D(self, w, theta):
+        h = self.hyp
+        if h.crack is not None:
+            dK = h.crack(theta)
+            return np.broadcast_to(dK, (w.size,) + dK.shape).astype(complex)
+        s = (np.ones_like(w), 1j * w, -w * w)[h.order]
+        return s[:, None, None] * h.pattern[None]
+
+    def responses(self, theta: float, derivative: bool = False):
+        """Per channel ``H(theta)`` (and ``dH/dtheta`` when asked; for gains d/d ln g)."""
+        h = self.hyp
+        Hs, dHs = [], []
+        for ch, H0, piece in zip(self.data.chans, self.data.H0, self.pieces):
+            if h.gain is not None:
+                hit = (h.gain[0] == "sensor" and ch.out_dof == h.gain[1]) or \
+                      (h.gain[0] == "exciter" and ch.in_spec == h.gain[1])
+                g = theta if hit else 1.0
+                Hs.append(H0 * g)
+                dHs.append(H0 / theta if hit else np.zeros_like(H0))
+                continue
+            y, z, RUU, w = piece
+            nU = len(h.dofs)
+            if h.crack is not None:
+                Dt = self._D(w, theta)            # already scaled by the depth
+                scale = 1.0
+            else:
+                Dt = self._D(w, 1.0)
+                scale = theta
+            A = np.eye(nU)[None] + scale * RUU @ Dt            # I + theta R D
+            u = np.linalg.solve(A, y[:, :, None])[:, :, 0]
+            Du = (Dt @ u[:, :, None])[:, :, 0]
+            H = H0 - scale * np.einsum("ku,ku->k", z, Du)
+            Hs.append(H)
+            if derivative:
+                if h.crack is not None:
+                    dHs.append(None)
+                else:
+                    A2 = np.eye(nU)[None] + theta * Dt @ RUU       # I + theta D R
+                    t = np.linalg.solve(A2, Du[:, :, None])[:, :, 0]
+                    dHs.append(-np.einsum("ku,ku->k", z, t))
+        return (Hs, dHs) if derivative else Hs
+
+
+def _rss(Hs, meas) -> float:
+    r = np.concatenate([np.log(h / m) for h, m in zip(Hs, meas)])
+    return float(np.sum(r.real ** 2 + r.imag ** 2))
+
+
+def _fit_size(ev: _Evaluator, n_scan: int = 25, gn_iter: int = 30):
+    """Least-squares size of one hypothesis: scan for a start, then Gauss-Newton (or golden section)."""
+    h = ev.hyp
+    meas = ev.data.meas
+
+    def rss(t):
+        try:
+            Hs = ev.responses(t)
+        except np.linalg.LinAlgError:
+            return math.inf
+        with np.errstate(all="ignore"):
+            v = _rss(Hs, meas)
+        return v if math.isfinite(v) else math.inf
+
+    if h.gain is not None:
+        # ln g enters linearly: closed form over the affected channels
+        r = []
+        for ch, H0, m in zip(ev.data.chans, ev.data.H0, meas):
+            hit = (h.gain[0] == "sensor" and ch.out_dof == h.gain[1]) or \
+                  (h.gain[0] == "exciter" and ch.in_spec == h.gain[1])
+            if hit:
+                r.append(np.log(H0 / m).real)
+        g = float(np.exp(-np.mean(np.concatenate(r))))
+        g = min(max(g, h.lower), h.upper)
+        return g, rss(g)
+
+    # scan: the null size, and sizes over four decades either side of the typical scale
+    mags = h.scale * np.logspace(-3, 1, n_scan)
+    grid = [0.0] + [m for m in mags if h.lower <= m <= h.upper] + [-m for m in mags if h.lower <= -m <= h.upper]
+    vals = [rss(t) for t in grid]
+    k = int(np.argmin(vals))
+    t, best = grid[k], vals[k]
+    if h.crack is not None:
+        # one-dimensional and smooth: golden-section refinement between the scan neighbours
+        srt = sorted(grid)
+        j = srt.index(t)
+        a, b = srt[max(j - 1, 0)], srt[min(j + 1, len(srt) - 1)]
+        import scipy.optimize as so
+        res = so.minimize_scalar(rss, bounds=(a, b), method="bounded", options={"xatol": 1e-6})
+        if res.fun < best:
+            t, best = float(res.x), float(res.fun)
+        return t, best
+    for _ in range(gn_iter):
+        Hs, dHs = ev.responses(t, derivative=True)
+        r = np.concatenate([np.log(hh / m) for hh, m in zip(Hs, meas)])
+        J = np.concatenate([d / hh for d, hh in zip(dHs, Hs)])
+        den = float(np.sum(np.abs(J) ** 2))
+        if not den > 0:
+            break
+        step = -float(np.sum((np.conj(J) * r).real)) / den
+        lam = 1.0
+        improved = False
+        while lam > 1e-4:
+            tn = min(max(t + lam * step, h.lower), h.upper)
+            vn = rss(tn)
+            if vn < best:
+                improved = True
+                break
+            lam *= 0.5
+        if not improved:
+            break
+        rel = abs(tn - t) / max(abs(t), 1e-12 * h.scale)
+        t, best = tn, vn
+        if rel < 1e-9:
+            break
+    return t, best
+
+
+def _jacobian_std(ev: _Evaluator, theta: float, s2: float) -> float:
+    """Linearised standard uncertainty of the size: s * (J^T J)^{-1/2} (J from a central difference)."""
+    h = ev.hyp
+    if h.gain is not None:
+        Hs, dHs = ev.responses(theta, derivative=True)
+    elif h.crack is None:
+        Hs, dHs = ev.responses(theta, derivative=True)
+    else:
+        d = max(1e-4, 1e-3 * abs(theta))
+        lo, hi = max(theta - d, 0.0), theta + d
+        Hl, Hh = ev.responses(lo), ev.responses(hi)
+        Hs = ev.responses(theta)
+        dHs = [(b - a) / (hi - lo) for a, b in zip(Hl, Hh)]
+    J = np.concatenate([d / hh for d, hh in zip(dHs, Hs)])
+    den = float(np.sum(np.abs(J) ** 2))
+    return math.sqrt(s2 / den) if den > 0 else math.inf
+
+
+def _separating_station(rec: _Receptance, fit: _Data, cands: list, model) -> int | None:
+    """Station whose (translational) response would best separate the candidates' fitted models."""
+    lay = model.layout
+    best, best_station = -1.0, None
+    for s in range(1, lay.n_nodes + 1):
+        d = lay.dof(s, "x" if lay.kind == "lumped" else "u")
+        resp = []
+        for f in cands:
+            h = f.hypothesis
+            hs = []
+            for ch, idx, b in zip(fit.chans, fit.idx, fit.b):
+                probe = _Chan(ch.frf, ch.label, ch.in_spec, ch.in_col, ch.in_name, ch.in_station, d, "probe", s,
+                              ch.speed)
+                Rk = rec.R[idx]
+                H0 = Rk[:, d, :] @ b
+                data = _Data([probe], [idx], [H0], [H0], [b])
+                hs.append(_Evaluator(rec, data, h).responses(f.value)[0])
+            resp.append(np.concatenate(hs))
+        sep = min(float(np.sqrt(np.mean(np.abs(np.log(resp[i] / resp[j])) ** 2)))
+                  for i in range(len(resp)) for j in range(i + 1, len(resp)))
+        if sep > best:
+            best, best_station = sep, s
+    return best_station
