@@ -37,6 +37,11 @@ File format
 :func:`read_frf` converts the response to SI (m/N or m/A).  Every format error
 raises :class:`FRFFileError` naming the file, the line and the field.
 
+Universal File Format data set 58 (``.uff``/``.unv``, the export of modal-test
+software) is read too: :func:`read_frf` and :func:`read_frfs` hand such a file
+to :func:`mutext.uff.read_uff58`, which converts velocity or acceleration per
+force to displacement per force in SI; :func:`mutext.uff.write_uff58` writes it.
+
 The virtual rig :func:`measure` produces the same :class:`FRF` objects from
 a model, with optional measurement noise, so that identification code can be
 exercised on data with a known truth.  The thesis sweeps ([Mad]_ sec. 4.3)
@@ -101,15 +106,22 @@ class FRFFileError(ModelError):
     line : int or None
         1-based line number, or None for whole-file problems.
     field : str or None
-        Header key or CSV column concerned.
+        Header key or CSV column concerned (for a Universal File: the data set
+        58 field, e.g. ``ord_data_type``, ``rsp_dir``).
+    dataset : int or None
+        For a Universal File (:mod:`mutext.uff`): the 1-based position of the
+        data set in the file, or None for whole-file problems.
     """
 
-    def __init__(self, path, line, field, problem):
+    def __init__(self, path, line, field, problem, *, dataset=None):
         self.path = str(path)
         self.line = line
         self.field = field
         self.problem = problem
+        self.dataset = dataset
         where = self.path if line is None else f"{self.path}, line {line}"
+        if dataset is not None:
+            where += f", data set {dataset}"
         what = f" [{field}]" if field else ""
         super().__init__(f"{where}{what}: {problem}")
 
@@ -136,12 +148,20 @@ def _parse_int(text: str, path, line: int, fld: str) -> int:
         raise FRFFileError(path, line, fld, f"{text.strip()!r} is not an integer") from None
 
 
-def read_frf(path) -> FRF:
+def read_frf(path, *, mapping=None) -> FRF:
     """Read one FRF file (format in the module docstring); the response is converted to SI.
+
+    A Universal File (extension ``.uff`` or ``.unv``, or content starting with
+    a ``    -1`` line) is read by :func:`mutext.uff.read_uff58` (data set 58,
+    velocity and acceleration converted to displacement per force); it must
+    hold exactly one FRF -- use :func:`read_frfs` for a file with several.
 
     Parameters
     ----------
     path : str or os.PathLike
+    mapping : dict of int -> int, optional
+        For a Universal File only: UFF node -> model station
+        (:func:`mutext.uff.read_uff58`; default station = node).
 
     Returns
     -------
@@ -158,9 +178,19 @@ def read_frf(path) -> FRF:
         key, an unknown quantity or unit, a station that is not an integer,
         a missing or wrong CSV header, a row without three columns, a value
         that is not a number or is NaN/infinite, a non-positive or
-        non-increasing frequency, and a file without data rows.
+        non-increasing frequency, and a file without data rows; for a
+        Universal File, naming the data set and field (:mod:`mutext.uff`), and
+        a file with more than one FRF.
     """
     path = Path(path)
+    from .uff import is_uff_file, read_uff58
+    if is_uff_file(path):
+        frfs = read_uff58(path, mapping=mapping)
+        if len(frfs) != 1:
+            sets = ", ".join(f["uff_dataset"] for f in (h.metadata for h in frfs))
+            raise FRFFileError(path, None, None, f"the Universal File holds {len(frfs)} FRFs (data sets {sets}); "
+                                                 f"read_frf reads one -- use read_frfs to read them all")
+        return frfs[0]
     try:
         raw = path.read_bytes()
     except OSError as exc:
@@ -337,7 +367,7 @@ def write_frf(path, frf: FRF, *, output_unit: str = "m") -> Path:
     return path
 
 
-def read_frfs(paths_or_glob) -> list[FRF]:
+def read_frfs(paths_or_glob, *, mapping=None) -> list[FRF]:
     """Read several FRF files.
 
     Parameters
@@ -345,6 +375,10 @@ def read_frfs(paths_or_glob) -> list[FRF]:
     paths_or_glob : str, os.PathLike or iterable of them
         A glob pattern (``"data/cracked_*.frf"``; matches are sorted by
         name), a single path, or a sequence of paths (kept in order).
+        A Universal File contributes all its FRF data sets 58, in file order
+        (:func:`mutext.uff.read_uff58`).
+    mapping : dict of int -> int, optional
+        For Universal Files: UFF node -> model station.
 
     Returns
     -------
@@ -362,7 +396,14 @@ def read_frfs(paths_or_glob) -> list[FRF]:
         paths = list(paths_or_glob)
         if not paths:
             raise ModelError("read_frfs: empty list of paths")
-    return [read_frf(p) for p in paths]
+    from .uff import is_uff_file, read_uff58
+    out: list[FRF] = []
+    for p in paths:
+        if is_uff_file(p):
+            out.extend(read_uff58(p, mapping=mapping))
+        else:
+            out.append(read_frf(p))
+    return out
 
 
 # ----------------------------------------------------------------------------

@@ -6,7 +6,8 @@ import sys
 
 def add_arguments(p):
     p.add_argument("model", help="model file (TOML): a lumped chain or a rotor")
-    p.add_argument("data", nargs="+", help="measured FRF files (freq_hz,re,im with a '# key: value' header)")
+    p.add_argument("data", nargs="+", help="measured FRF files (freq_hz,re,im with a '# key: value' header, or "
+                                           "Universal File data set 58 .uff/.unv, all its FRFs)")
     p.add_argument("--validate", nargs="+", default=[], metavar="FILE",
                    help="FRF files held out of the fit, on which the gain is measured (default: every 5th "
                         "frequency of the fitted files)")
@@ -24,10 +25,14 @@ def add_arguments(p):
 
 def run(args) -> int:
     from ..diagnose import diagnose
+    from ..progress import ProgressLine
     from ..report import to_json, write_diagnosis
-    from .progress import ProgressLine
+    from ..rig import read_frfs
     prog = ProgressLine(enabled=not args.quiet)
-    res = diagnose(args.model, args.data, validate=args.validate or None, alpha=args.alpha, noise=args.noise,
+    # read_frfs: a Universal File may hold several FRFs (data sets 58), all used
+    data = read_frfs(args.data)
+    validate = read_frfs(args.validate) if args.validate else None
+    res = diagnose(args.model, data, validate=validate, alpha=args.alpha, noise=args.noise,
                    progress=prog, mbi=args.mbi)
     if args.out:
         prog("writing the report", 1.0)

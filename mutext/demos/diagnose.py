@@ -32,7 +32,7 @@ def add_arguments(p):
 
 
 def run(args) -> int:
-    from ..commands.progress import ProgressLine
+    from ..progress import ProgressLine
     from ..report import to_json, write_diagnosis
     out = args.out or tempfile.mkdtemp(prefix="mutext-diagnose-")
     case = hidden_effect_data(args.example, seed=args.seed, kind=args.kind, noise=args.noise,

@@ -13,7 +13,7 @@ import scipy.stats as sst
 from ..errors import ModelError
 from ..frfit import noise_level
 from ..response import FRF
-from ..rig import read_frf
+from ..rig import read_frfs
 from ..rotor.model import load_model, loads_model
 from ..rotor.tuning import model_response
 from ._compare import _errors, _model_modes, _resonance_table, _summary
@@ -27,12 +27,15 @@ log = logging.getLogger("mutext.diagnose")
 #: Without validation files, every this many-th frequency of each channel is held out of the fit.
 HOLDOUT_EVERY = 5
 
-def _as_frfs(frfs, what) -> list[FRF]:
+def _as_frfs(frfs) -> list[FRF]:
+    """FRFs given as objects or files (a Universal File may hold several: all are used)."""
     if frfs is None:
         return []
     if isinstance(frfs, (FRF, str, os.PathLike)):
         frfs = [frfs]
-    out = [f if isinstance(f, FRF) else read_frf(f) for f in frfs]
+    out = []
+    for f in frfs:
+        out += [f] if isinstance(f, FRF) else read_frfs([f])
     return out
 
 
@@ -163,10 +166,10 @@ def _inputs(model, frfs, validate, alpha):
         model_text = fh.read()
     if not 0 < alpha < 1:
         raise ModelError(f"diagnose: alpha must be in (0, 1), got {alpha}")
-    fit_frfs = _as_frfs(frfs, "data")
+    fit_frfs = _as_frfs(frfs)
     if not fit_frfs:
         raise ModelError("diagnose: no measured FRF given")
-    val_frfs = _as_frfs(validate, "validation")
+    val_frfs = _as_frfs(validate)
     for v in val_frfs:
         for f in fit_frfs:
             if _same_data(v, f):
