@@ -152,3 +152,137 @@ def test_balance_states_keeps_transfer_function():
     _resp_close(bal, G, np.logspace(-2, 2, 11), rtol=1e-8)
     A = np.abs(np.asarray(bal.A))
     assert A.max() / A[A > 0].min() < np.abs(np.asarray(Gb.A)).max() / np.abs(np.asarray(Gb.A))[A > 0].min()
+
+
+# ------------------------------------------- stiff and badly scaled systems (issue 20)
+
+def _direct(sys, omega):
+    """Independent reference: C (jwI - A)^{-1} B + D by a dense complex solve per
+    frequency, in the system's own coordinates (no balancing, no Hessenberg form)."""
+    A, B, C, D = (np.asarray(X, float) for X in (sys.A, sys.B, sys.C, sys.D))
+    n = A.shape[0]
+    return np.stack([C @ np.linalg.solve(1j * w * np.eye(n) - A, B) + D for w in omega], axis=-1)
+
+
+def _relerr(G, R):
+    """Largest relative error (Frobenius norm per frequency)."""
+    return float(np.max(np.linalg.norm(G - R, axis=(0, 1)) / np.linalg.norm(R, axis=(0, 1))))
+
+
+def _stiff_closed_loop():
+    """The near-axis plant of the tests (D-scaled distillation column, weight poles at
+    -1e-6 rad/s) closed by slycot's H-infinity controller (a pole at -5.9e6 rad/s):
+    matrix balancing of the closed loop spans ~1e11."""
+    from pathlib import Path
+    pytest.importorskip("slycot")
+    data = np.load(Path(__file__).parent / "data" / "near_axis_plant.npz")
+    P = ss(data["A"], data["B"], data["C"], data["D"])
+    K = ct.hinfsyn(P, 2, 2)[0]
+    return lft_lower(P, K, 2, 2)
+
+
+def test_freqresp_stiff_closed_loop_matches_direct_solve():
+    CL = _stiff_closed_loop()
+    lam = np.linalg.eigvals(np.asarray(CL.A))
+    assert np.abs(lam).max() > 1e6 and np.abs(lam).min() < 1e-5   # really stiff
+    w = np.concatenate([[0.0], np.logspace(-8, 9, 60)])
+    # the direct solve itself is right to ~3e-7 here (checked against mpmath below):
+    # the problem's conditioning, ||A|| ||A^-1|| eps ~ 0.3 at DC, is far worse
+    assert _relerr(freqresp(CL, w), _direct(CL, w)) < 2e-6
+    # the Hessenberg-after-balancing route this replaced had a relative error of 2e5 at DC
+
+
+def test_freqresp_stiff_closed_loop_matches_mpmath():
+    mp = pytest.importorskip("mpmath")
+    CL = _stiff_closed_loop()
+    A, B, C, D = (np.asarray(X, float) for X in (CL.A, CL.B, CL.C, CL.D))
+    n = A.shape[0]
+    w = [0.0, 1e-6, 1e-2, 1.0, 1e3, 1e7]
+    G = freqresp(CL, w)
+    with mp.workdps(40):
+        Am, Bm, Cm = mp.matrix(A.tolist()), mp.matrix(B.tolist()), mp.matrix(C.tolist())
+        for k, wk in enumerate(w):
+            M = -Am
+            for i in range(n):
+                M[i, i] += mp.mpc(0, wk)
+            X = mp.matrix(n, B.shape[1])
+            for j in range(B.shape[1]):
+                x = mp.lu_solve(M, Bm[:, j])
+                for i in range(n):
+                    X[i, j] = x[i]
+            Y = Cm * X
+            R = np.array([[complex(Y[i, j]) for j in range(Y.cols)] for i in range(Y.rows)]) + D
+            assert np.linalg.norm(G[:, :, k] - R) <= 1e-6 * np.linalg.norm(R), wk
+
+
+@pytest.mark.parametrize("seed", range(10))
+def test_freqresp_badly_scaled_states(seed):
+    """States rescaled by factors 1e-8..1e8 (rounded, so the scaled system is a tiny
+    componentwise perturbation): the response must stay that of the unscaled one."""
+    rng = np.random.default_rng(100 + seed)
+    n = int(rng.integers(3, 25))
+    G = _rand_stable(rng, n, 3, 2)
+    t = 10.0 ** rng.uniform(-8, 8, n)
+    A, B, C = (np.asarray(X, float) for X in (G.A, G.B, G.C))
+    Gs = ss(A / t[:, None] * t[None, :], B / t[:, None], C * t[None, :], G.D)
+    w = np.logspace(-3, 3, 80)
+    assert _relerr(freqresp(Gs, w), _direct(G, w)) < 1e-9
+
+
+def test_freqresp_matches_python_control_on_normal_systems():
+    rng = np.random.default_rng(7)
+    for _ in range(10):
+        G = _rand_stable(rng, int(rng.integers(1, 30)), 2, 3)
+        w = np.logspace(-2, 2, 50)
+        ref = ct.frequency_response(G, w).complex.reshape(3, 2, -1)
+        assert _relerr(freqresp(G, w), ref) < 1e-9
+
+
+# ------------------------------------------- imaginary-axis test (issue 20)
+
+def test_hinf_norm_slow_stable_pole_beside_fast_one_is_not_on_axis():
+    # 1e-6/(s + 1e-6) + 1e8/(s + 1e8): peak 2 at DC; the old rule |Re p| <= 1e-12 max|p|
+    # called the pole at -1e-6 "on the axis" and returned inf
+    G = ss(np.diag([-1e-6, -1e8]), [[1e-6], [1e8]], [[1.0, 1.0]], [[0.0]])
+    nrm = hinf_norm(G)
+    assert nrm.value == pytest.approx(2.0, rel=1e-9)
+    assert nrm.value == pytest.approx(ct.norm(G, "inf"), rel=1e-6)
+
+
+@pytest.mark.parametrize("seed", range(5))
+def test_hinf_norm_true_axis_poles_found_in_stiff_systems(seed):
+    """An integrator and an undamped mode at 3 rad/s hidden by a random similarity in a
+    system with poles at -1e-6 and -1e8: computed real parts are rounding noise of
+    size eps ||A||, so the axis test must use the pole's own error, not just its size."""
+    rng = np.random.default_rng(seed)
+    A0 = np.zeros((5, 5))
+    A0[1:3, 1:3] = [[0.0, 3.0], [-3.0, 0.0]]
+    A0[3, 3], A0[4, 4] = -1e-6, -1e8
+    T = rng.standard_normal((5, 5)) + 3 * np.eye(5)
+    A = np.linalg.solve(T, A0 @ T)
+    B, C = rng.standard_normal((5, 2)), rng.standard_normal((2, 5))
+    assert hinf_norm(ss(A, B, C, np.zeros((2, 2)))).value == np.inf
+    # without the integrator and the undamped mode (same fast and slow poles) it is finite
+    # (its value is itself ill-conditioned: T mixes the -1e-6 pole with the -1e8 one)
+    A1 = A0.copy()
+    A1[0, 0] = -1.0
+    A1[1:3, 1:3] = [[-0.1, 3.0], [-3.0, -0.1]]
+    G1 = ss(np.linalg.solve(T, A1 @ T), B, C, np.zeros((2, 2)))
+    assert 0 < hinf_norm(G1).value < np.inf
+
+
+def test_hinf_norm_stiff_closed_loop_matches_mpmath_peak():
+    """slycot's controller on the near-axis plant: the response is flat and peaks at DC.
+    Old code: inf (the -1e-6 poles flagged beside the 5.9e6 controller pole).  The
+    reference is the DC gain in 40-digit arithmetic, 1.04814832346..."""
+    mp = pytest.importorskip("mpmath")
+    CL = _stiff_closed_loop()
+    A, B, C, D = (np.asarray(X, float) for X in (CL.A, CL.B, CL.C, CL.D))
+    with mp.workdps(40):
+        Am, Bm, Cm = -mp.matrix(A.tolist()), mp.matrix(B.tolist()), mp.matrix(C.tolist())
+        G0 = np.array([[float((Cm[i, :] * mp.lu_solve(Am, Bm[:, j]))[0]) for j in range(B.shape[1])]
+                       for i in range(C.shape[0])]) + D
+    dc = np.linalg.norm(G0, 2)
+    nrm = hinf_norm(CL)
+    assert np.isfinite(nrm.value)
+    assert nrm.value == pytest.approx(dc, rel=1e-6)
