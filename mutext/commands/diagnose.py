@@ -1,12 +1,14 @@
-"""``mutext diagnose MODEL.toml DATA.csv [...] [--validate VAL.csv ...] [--out DIR] [--json]``."""
+"""``mutext diagnose MODEL.toml DATA.csv [...] [--validate VAL.csv ...] [--out DIR] [--json]``,
+or ``mutext diagnose --batch DIR [--jobs N]`` for every data set under DIR."""
 from __future__ import annotations
 
+import os
 import sys
 
 
 def add_arguments(p):
-    p.add_argument("model", help="model file (TOML): a lumped chain or a rotor")
-    p.add_argument("data", nargs="+", help="measured FRF files (freq_hz,re,im with a '# key: value' header, or "
+    p.add_argument("model", nargs="?", help="model file (TOML): a lumped chain or a rotor")
+    p.add_argument("data", nargs="*", help="measured FRF files (freq_hz,re,im with a '# key: value' header, or "
                                            "Universal File data set 58 .uff/.unv, all its FRFs)")
     p.add_argument("--validate", nargs="+", default=[], metavar="FILE",
                    help="FRF files held out of the fit, on which the gain is measured (default: every 5th "
@@ -20,15 +22,48 @@ def add_arguments(p):
     p.add_argument("--mbi", action="store_true",
                    help="also read the top finding by model-based identification (lumped chains; D-K iteration, "
                         "5-60 s more)")
+    p.add_argument("--batch", metavar="DIR", help="diagnose every data set under DIR (a folder with model.toml and "
+                                                  "measured/, as 'mutext rig hide' writes); reports beside the data, "
+                                                  "summary.csv and index.html in DIR")
+    p.add_argument("--jobs", type=int, default=1, help="parallel workers for --batch (-1: all cores)")
     p.add_argument("--quiet", action="store_true", help="no progress output")
+
+
+def _batch(args, prog) -> int:
+    from ..batch import diagnose_batch
+    from ..errors import ModelError
+    if args.model or args.data or args.validate or args.out:
+        raise ModelError("--batch takes a directory only (each data set holds its model and files)")
+    rows = diagnose_batch(args.batch, jobs=args.jobs, mbi=args.mbi, progress=prog)
+    if args.json:
+        import json
+        print(json.dumps(rows, default=str))
+        return 0
+    print(f"{'data set':<28} {'status':<7} {'verdict':<28} {'gain':>7} {'right':>6}")
+    for r in rows:
+        name = os.path.relpath(r["data_set"], args.batch)
+        verdict = f"{r.get('kind', '')} at {r.get('station')}" if r["status"] == "ok" else r.get("error", "")[:60]
+        gain = f"{r['gain']:.3g}" if r.get("gain") is not None else ""
+        print(f"{name:<28} {r['status']:<7} {verdict:<28} {gain:>7} {str(r.get('found', '')):>6}")
+    keyed = [r for r in rows if "found" in r]
+    failed = [r for r in rows if r["status"] != "ok"]
+    print(f"{len(rows) - len(failed)} of {len(rows)} diagnosed" + (f", {len(failed)} failed" if failed else "")
+          + (f"; right in {sum(bool(r['found']) for r in keyed)} of {len(keyed)} with an answer key" if keyed else ""))
+    print(f"summary: {os.path.join(args.batch, 'summary.csv')}, {os.path.join(args.batch, 'index.html')}")
+    return 0
 
 
 def run(args) -> int:
     from ..diagnose import diagnose
+    from ..errors import ModelError
     from ..progress import ProgressLine
     from ..report import to_json, write_diagnosis
     from ..rig import read_frfs
     prog = ProgressLine(enabled=not args.quiet)
+    if args.batch:
+        return _batch(args, prog)
+    if not args.model or not args.data:
+        raise ModelError("give a model file and at least one measured FRF file (or --batch DIR)")
     # read_frfs: a Universal File may hold several FRFs (data sets 58), all used
     data = read_frfs(args.data)
     validate = read_frfs(args.validate) if args.validate else None

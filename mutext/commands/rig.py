@@ -16,11 +16,24 @@ def add_arguments(p):
     h.add_argument("--kind", default=None, help="force the kind of effect (stiffness, mass, damping, bearing, "
                                                 "crack, sensor_gain, exciter_gain, none)")
     h.add_argument("--noise", type=float, default=0.01, help="relative noise level (default 0.01 = 1 %%)")
+    h.add_argument("--count", type=int, default=1,
+                   help="write COUNT data sets, seeds SEED..SEED+COUNT-1, in DIR/case_<seed> (a class or a study)")
     h.add_argument("--show-key", action="store_true", help="also print the answer key")
 
 
 def run(args) -> int:
+    import os
+    from ..errors import ModelError
     from ..hide import hidden_effect_data
+    if args.count < 1:
+        raise ModelError(f"--count must be at least 1, got {args.count}")
+    if args.count > 1:
+        for seed in range(args.seed, args.seed + args.count):
+            hidden_effect_data(args.example, seed=seed, kind=args.kind, noise=args.noise,
+                               out_dir=os.path.join(args.out, f"case_{seed}"))
+        print(f"{args.count} data sets in {args.out}/case_<seed> (answer keys inside: keep them apart)")
+        print(f"try: mutext diagnose --batch {args.out} --jobs 2")
+        return 0
     case = hidden_effect_data(args.example, seed=args.seed, kind=args.kind, noise=args.noise, out_dir=args.out)
     f = case.files
     print(f"model:     {f['model']}")

@@ -1,0 +1,162 @@
+r"""Many diagnoses at once: a class's hidden-effect sets, a fleet of machines, a Monte Carlo study.
+
+:func:`diagnose_batch` finds every data set under a directory -- a folder
+holding a model file ``model.toml`` and its measured FRFs in ``measured/``
+(CSV or UFF 58), optionally ``validate/`` and an ``answer_key.json``, as
+``mutext rig hide`` writes them -- runs :func:`mutext.diagnose.diagnose` on
+each, writes each result beside its data (``<set>/diagnosis/``: report,
+figures, ``diagnosis.json``, extended model) and a summary
+(``summary.csv`` and ``index.html`` in the directory).  A data set that
+fails is reported in the summary with its error; the others go on.
+
+Parallel runs go through joblib (one process per data set, ``jobs``
+workers, one BLAS thread each).  On a cluster, the same call runs on Dask
+through joblib's Dask backend::
+
+    from dask.distributed import Client
+    import joblib
+    client = Client("scheduler-address:8786")        # or Client() for a local cluster
+    with joblib.parallel_backend("dask"):
+        rows = diagnose_batch("cases/", jobs=-1)
+
+With an answer key the summary says whether the verdict's kind and place
+match it (the Monte Carlo success rate of ``benchmarks/bench_diagnose.py``).
+"""
+from __future__ import annotations
+
+import csv
+import html
+import json
+import os
+import time
+import traceback
+from pathlib import Path
+
+from .errors import ModelError
+
+__all__ = ["diagnose_batch", "find_data_sets", "SUMMARY_FIELDS"]
+
+#: Columns of ``summary.csv``.
+SUMMARY_FIELDS = ("data_set", "status", "kind", "station", "element", "value", "unit", "std", "gain",
+                  "error_before", "error_after", "noise", "seconds", "key_kind", "key_station", "key_value",
+                  "found", "error")
+
+
+def find_data_sets(root) -> list[Path]:
+    """Folders under ``root`` (itself included) with a ``model.toml`` and a non-empty ``measured/``."""
+    root = Path(root)
+    if not root.is_dir():
+        raise ModelError(f"batch: '{root}' is not a directory")
+    found = []
+    for model in sorted(root.rglob("model.toml")):
+        d = model.parent
+        if (d / "measured").is_dir() and any(p.is_file() for p in (d / "measured").iterdir()):
+            found.append(d)
+    return found
+
+
+def _files(folder: Path) -> list[str]:
+    return [str(p) for p in sorted(folder.iterdir()) if p.is_file() and p.suffix.lower() in (".csv", ".uff", ".unv")] \
+        if folder.is_dir() else []
+
+
+def _one(folder: str, out_name: str, mbi: bool) -> dict:
+    """Diagnose one data set and write its report; never raises (failures are rows too)."""
+    from threadpoolctl import threadpool_limits
+    from .diagnose import diagnose
+    from .report import write_diagnosis
+    d = Path(folder)
+    row = {"data_set": str(d), "status": "ok"}
+    t0 = time.perf_counter()
+    try:
+        with threadpool_limits(1, "blas"):
+            res = diagnose(str(d / "model.toml"), _files(d / "measured"), validate=_files(d / "validate") or None,
+                           mbi=mbi)
+            write_diagnosis(res, d / out_name)
+        v = res.verdict
+        row.update(kind=v.kind, station=v.station, element=v.element, value=v.value, unit=v.unit, std=v.std,
+                   gain=res.gain, error_before=res.error_before["rel"], error_after=res.error_after["rel"],
+                   noise=res.noise)
+    except Exception as exc:      # noqa: BLE001 - one bad data set must not stop the batch
+        row.update(status="failed", error=f"{type(exc).__name__}: {exc}".splitlines()[0])
+        if not isinstance(exc, ModelError):
+            row["error"] += f" ({traceback.extract_tb(exc.__traceback__)[-1].name})"
+    row["seconds"] = time.perf_counter() - t0
+    key = d / "answer_key.json"
+    if key.is_file():
+        try:
+            k = json.loads(key.read_text(encoding="utf-8"))
+            row.update(key_kind=k.get("kind"), key_station=k.get("station"), key_value=k.get("value"))
+            if row["status"] == "ok":
+                row["found"] = (row["kind"], row["station"]) == (k.get("kind"), k.get("station"))
+        except (OSError, ValueError) as exc:
+            row["error"] = f"answer key unreadable: {exc}"
+    return row
+
+
+def diagnose_batch(root, *, jobs: int = 1, out_name: str = "diagnosis", mbi: bool = False,
+                   progress=None) -> list[dict]:
+    """Diagnose every data set under ``root``; write each report beside its data and a summary.
+
+    Parameters
+    ----------
+    root : path
+        Directory searched by :func:`find_data_sets`.
+    jobs : int
+        Parallel workers (joblib; -1 for all cores, or the Dask backend's workers).
+    out_name : str
+        Folder written inside each data set.
+    mbi : bool
+        Also the model-based-identification reading (lumped chains; slower).
+    progress : callable(stage, fraction), optional
+
+    Returns
+    -------
+    list of dict
+        One row per data set (:data:`SUMMARY_FIELDS`); also written to
+        ``root/summary.csv`` and ``root/index.html``.
+    """
+    import joblib
+    sets = find_data_sets(root)
+    if not sets:
+        raise ModelError(f"batch: no data set under '{root}' (a folder with model.toml and measured/*.csv, "
+                         f"as 'mutext rig hide' writes)")
+    if isinstance(jobs, bool) or not isinstance(jobs, int) or jobs == 0:
+        raise ModelError(f"batch: jobs must be a positive number of workers or -1, got {jobs!r}")
+    rows = []
+    par = joblib.Parallel(n_jobs=jobs, return_as="generator")
+    for k, row in enumerate(par(joblib.delayed(_one)(str(d), out_name, mbi) for d in sets), start=1):
+        rows.append(row)
+        if progress is not None:
+            progress(f"data set {k}/{len(sets)}: {Path(row['data_set']).name} {row['status']}", k / len(sets))
+    _write_summary(Path(root), rows, out_name)
+    return rows
+
+
+def _write_summary(root: Path, rows: list, out_name: str):
+    with open(root / "summary.csv", "w", newline="", encoding="utf-8") as fh:
+        w = csv.DictWriter(fh, fieldnames=SUMMARY_FIELDS, extrasaction="ignore")
+        w.writeheader()
+        for r in rows:
+            w.writerow({k: r.get(k, "") for k in SUMMARY_FIELDS})
+    e = html.escape
+    keyed = [r for r in rows if "found" in r]
+    head = (f"<p>{sum(r['status'] == 'ok' for r in rows)} of {len(rows)} data sets diagnosed"
+            + (f"; verdict right (kind and place) in {sum(bool(r['found']) for r in keyed)} of {len(keyed)} "
+               f"with an answer key" if keyed else "") + ".</p>")
+    body = "".join(_row_html(r, root, out_name) for r in rows)
+    (root / "index.html").write_text(
+        "<!DOCTYPE html><html><head><meta charset=\"utf-8\"><title>mutext diagnose: batch</title></head><body>"
+        f"<h1>Diagnoses under {e(str(root))}</h1>{head}<table border=\"1\" cellpadding=\"3\"><tr><th>data set</th>"
+        "<th>status</th><th>kind</th><th>station</th><th>size</th><th>gain</th><th>right</th><th>error</th></tr>"
+        f"{body}</table></body></html>\n", encoding="utf-8")
+
+
+def _row_html(r: dict, root: Path, out_name: str) -> str:
+    e = html.escape
+    name = e(os.path.relpath(r["data_set"], root))
+    size = "" if r.get("value") is None else f"{r['value']:.4g} {e(r.get('unit', ''))}"
+    gain = "" if r.get("gain") is None else f"{r['gain']:.3g}"
+    return (f"<tr><td><a href=\"{name}/{e(out_name)}/report.html\">{name}</a></td><td>{e(r['status'])}</td>"
+            f"<td>{e(str(r.get('kind', '')))}</td><td>{e(str(r.get('station', '') or ''))}</td><td>{size}</td>"
+            f"<td>{gain}</td><td>{e(str(r.get('found', '')))}</td><td>{e(r.get('error', ''))}</td></tr>")

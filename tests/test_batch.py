@@ -1,0 +1,56 @@
+"""Many data sets at once: rig hide --count, diagnose --batch, a failing set reported, Dask through joblib."""
+import csv
+import json
+
+import pytest
+
+from mutext.batch import diagnose_batch, find_data_sets
+from mutext.cli import main
+from mutext.errors import ModelError
+
+
+@pytest.fixture(scope="module")
+def cases(tmp_path_factory):
+    root = tmp_path_factory.mktemp("class")
+    assert main(["rig", "hide", "--seed", "10", "--count", "4", "--out", str(root)]) == 0
+    return root
+
+
+def test_batch_diagnoses_every_set_and_reports_a_broken_one(cases, capsys):
+    (cases / "case_12" / "measured" / "in1_out1.csv").write_text("not an FRF file\n")
+    capsys.readouterr()
+    assert main(["diagnose", "--batch", str(cases), "--jobs", "2", "--quiet"]) == 0
+    out = capsys.readouterr().out
+    assert "3 of 4 diagnosed, 1 failed; right in 3 of 3 with an answer key" in out
+    rows = list(csv.DictReader(open(cases / "summary.csv", encoding="utf-8")))
+    assert [r["status"] for r in rows] == ["ok", "ok", "failed", "ok"]
+    bad = rows[2]
+    assert "case_12/measured/in1_out1.csv" in bad["error"] and "FRFFileError" in bad["error"]
+    for r in rows:
+        if r["status"] == "ok":
+            assert r["found"] == "True"
+            rep = json.loads(open(f"{r['data_set']}/diagnosis/diagnosis.json", encoding="utf-8").read())
+            assert rep["verdict"]["kind"] == r["kind"]
+    assert "report.html" in (cases / "index.html").read_text()
+
+
+def test_batch_errors_are_named(tmp_path, cases):
+    with pytest.raises(ModelError, match="no data set under"):
+        diagnose_batch(tmp_path)
+    with pytest.raises(ModelError, match="not a directory"):
+        find_data_sets(tmp_path / "nope")
+    with pytest.raises(ModelError, match="jobs"):
+        diagnose_batch(cases, jobs=0)
+    assert main(["diagnose", "--batch", str(cases), "model.toml"]) == 1
+
+
+@pytest.mark.slow
+def test_batch_runs_on_a_local_dask_cluster(tmp_path):
+    distributed = pytest.importorskip("distributed")
+    import joblib
+    assert main(["rig", "hide", "--seed", "20", "--count", "3", "--out", str(tmp_path)]) == 0
+    with distributed.Client(n_workers=2, threads_per_worker=1, processes=True, dashboard_address=None):
+        with joblib.parallel_backend("dask"):
+            rows = diagnose_batch(tmp_path, jobs=-1)
+    assert [r["status"] for r in rows] == ["ok"] * 3
+    assert all(r["found"] for r in rows)
