@@ -218,7 +218,10 @@ def sweep_frequencies(start: float = 20.0, stop: float = 225.0, step: float = 0.
     The defaults give the thesis analysis band (20-225 Hz in 0.5 Hz steps,
     411 points); ``sweep_frequencies(*THESIS_SWEEP_HZ)`` the full 20-1000 Hz
     sweep.  The grid is computed as ``start + k*step`` (no accumulated
-    rounding); ``stop`` is included when it lies on the grid to 1e-9 steps.
+    rounding) and rounded to 12 significant digits of the largest frequency,
+    so that a decimal grid is written as decimals (``0.3``, not the
+    ``0.30000000000000004`` of ``0.2 + 5 * 0.02``); ``stop`` is included
+    when it lies on the grid to 1e-9 steps.
     """
     start, stop, step = float(start), float(stop), float(step)
     if not (math.isfinite(start) and math.isfinite(stop) and math.isfinite(step)):
@@ -227,4 +230,5 @@ def sweep_frequencies(start: float = 20.0, stop: float = 225.0, step: float = 0.
         raise ModelError(f"sweep_frequencies: need 0 < start <= stop and step > 0 [Hz], got "
                          f"start={start}, stop={stop}, step={step}")
     n = int(math.floor((stop - start) / step + 1e-9)) + 1
-    return start + step * np.arange(n)
+    f = start + step * np.arange(n)
+    return np.round(f, max(0, 11 - int(math.floor(math.log10(f[-1])))))

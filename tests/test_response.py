@@ -61,3 +61,13 @@ def test_docstring_example_runs():
     import mutext.response
     res = doctest.testmod(mutext.response)
     assert res.failed == 0 and res.attempted > 0
+
+
+def test_sweep_grid_is_written_as_decimals(tmp_path):
+    """A decimal sweep (0.2 Hz in 0.02 Hz steps) gives decimals in the file, not 0.30000000000000004."""
+    from mutext.response import sweep_frequencies
+    f = sweep_frequencies(0.2, 9.98, 0.02)
+    assert f.size == 490 and f[5] == 0.3 and f[-1] == 9.98
+    p = write_frf(tmp_path / "g.csv", FRF(f, np.ones(f.size), input_station=1, output_station=1))
+    rows = [ln.split(",")[0] for ln in p.read_text().splitlines() if ln[:1].isdigit()]
+    assert max(len(r) for r in rows) <= 4

@@ -33,10 +33,9 @@ def add_arguments(p):
 def measured_sweep(trial: str, noise: float, path, rng=0):
     """The true rig of ``trial`` swept on the virtual rig (0.2-10 Hz in 0.02 Hz steps, force
     at cart 1, displacement of cart 1), written to the FRF file ``path`` (in mm) and read back."""
-    import numpy as np
-    from ..rig import measure, read_frf, write_frf
+    from ..rig import measure, read_frf, sweep_frequencies, write_frf
     T = three_mass.mechanical_model(three_mass.TRIALS[trial].true)
-    frf = measure(T, "f1", "x1", np.arange(0.2, 10.0, 0.02), noise=noise, rng=rng, input_station=1,
+    frf = measure(T, "f1", "x1", sweep_frequencies(0.2, 9.98, 0.02), noise=noise, rng=rng, input_station=1,
                   output_station=1, metadata={"rig": f"three-mass, trial {trial} true values"})
     return read_frf(write_frf(path, frf, output_unit="mm"))
 
