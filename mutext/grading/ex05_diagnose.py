@@ -28,7 +28,7 @@ import math
 
 import numpy as np
 
-from .compare import fmt
+from .compare import as_array, fmt, returned
 from .core import Call, Exercise, Question
 
 POINTS = {"a": 1.5, "b": 2.0, "c": 2.0, "d": 4.5}
@@ -92,12 +92,6 @@ def _lists(X):
     return [list(map(float, r)) for r in np.asarray(X, float)]
 
 
-def _value(oc, size=None):
-    x = np.asarray(oc["value"]["data"] if isinstance(oc["value"], dict) else oc["value"], dtype=float)
-    x = x.ravel() if size is None else x
-    return x
-
-
 # ----------------------------------------------------------------------------
 # (a)
 # ----------------------------------------------------------------------------
@@ -116,16 +110,13 @@ def _a_cases():
 def _check_a(outcomes, calls):
     score, fb = 0.0, []
     per = POINTS["a"] / len(calls)
-    for oc, call in zip(outcomes, calls):
-        if not oc["ok"]:
-            fb.append(f"[{call.label}] {oc['error']}")
-            continue
-        x = float(oc["value"])
+    for call, tag, value in returned(outcomes, calls, fb):
+        x = float(value)
         ref = call.ref
         if math.isfinite(x) and abs(x - ref) <= RTOL_EXACT * abs(ref):
             score += per
             continue
-        msg = f"[{call.label}] RSS: expected {fmt(ref)}, got {fmt(x)}"
+        msg = f"{tag} RSS: expected {fmt(ref)}, got {fmt(x)}"
         if math.isfinite(x) and abs(x - call.unwrapped) <= 1e-6 * abs(call.unwrapped):
             msg += ("; this is the difference of the logs with each phase taken on its own: take the log of "
                     "the ratio H_model / H_measured so the phase difference stays in (-pi, pi]")
@@ -146,18 +137,10 @@ def _check_a(outcomes, calls):
 def _check_b(outcomes, calls):
     score, fb = 0.0, []
     per = POINTS["b"] / len(calls)
-    for oc, call in zip(outcomes, calls):
-        if not oc["ok"]:
-            fb.append(f"[{call.label}] {oc['error']}")
-            continue
-        try:
-            x = _value(oc)
-        except (TypeError, ValueError, KeyError) as exc:
-            fb.append(f"[{call.label}] the returned value is not an array of numbers ({exc})")
-            continue
+    for call, tag, x in returned(outcomes, calls, fb, as_array, "response"):
         ref = call.ref
         if x.size != 2 * ref.size:
-            fb.append(f"[{call.label}] expected an array of shape (2, {ref.size}) (real and imaginary parts), "
+            fb.append(f"{tag} expected an array of shape (2, {ref.size}) (real and imaginary parts), "
                       f"got {x.size} numbers")
             continue
         h = x.reshape(2, -1)
@@ -166,7 +149,7 @@ def _check_b(outcomes, calls):
         if err <= RTOL_EXACT:
             score += per
             continue
-        msg = f"[{call.label}] largest relative error {fmt(err)}"
+        msg = f"{tag} largest relative error {fmt(err)}"
         for name, alt in call.alternatives.items():
             if np.max(np.abs(h - alt) / np.abs(alt)) <= 1e-6:
                 msg += f"; this is {name}"
@@ -180,15 +163,12 @@ def _check_b(outcomes, calls):
 def _check_float_rel(outcomes, calls, rtol, points, what):
     score, fb = 0.0, []
     per = points / len(calls)
-    for oc, call in zip(outcomes, calls):
-        if not oc["ok"]:
-            fb.append(f"[{call.label}] {oc['error']}")
-            continue
-        x = float(oc["value"])
+    for call, tag, value in returned(outcomes, calls, fb):
+        x = float(value)
         if math.isfinite(x) and abs(x - call.ref) <= rtol * abs(call.ref):
             score += per
             continue
-        msg = f"[{call.label}] {what}: expected {fmt(call.ref)} within {rtol:.0%}, got {fmt(x)}"
+        msg = f"{tag} {what}: expected {fmt(call.ref)} within {rtol:.0%}, got {fmt(x)}"
         if math.isnan(x):
             msg += "; the answer is NaN"
         elif x > 0 and abs(x / call.ref - 1) > 0.5:
@@ -206,17 +186,10 @@ def _check_float_rel(outcomes, calls, rtol, points, what):
 def _check_d(outcomes, calls):
     per = POINTS["d"] / len(calls)
     score, fb = 0.0, []
-    for oc, call in zip(outcomes, calls):
-        if not oc["ok"]:
-            fb.append(f"[{call.label}] {oc['error']}")
-            continue
-        try:
-            x = _value(oc)
-        except (TypeError, ValueError, KeyError) as exc:
-            fb.append(f"[{call.label}] the returned value is not an array of numbers ({exc})")
-            continue
+    for call, tag, x in returned(outcomes, calls, fb, as_array, "find_effect()"):
+        x = x.ravel()
         if x.size != 3 or not np.all(np.isfinite(x)):
-            fb.append(f"[{call.label}] find_effect() must return three finite numbers [kind index, station, "
+            fb.append(f"{tag} find_effect() must return three finite numbers [kind index, station, "
                       f"size], got {x.tolist()}")
             continue
         kind, station, size = call.key
@@ -227,7 +200,7 @@ def _check_d(outcomes, calls):
             if got_kind == "none":
                 score += per
             else:
-                fb.append(f"[{call.label}] there is no effect in these data, you found {got_kind} at mass "
+                fb.append(f"{tag} there is no effect in these data, you found {got_kind} at mass "
                           f"{got_station}: is the improvement above 20 sigma^2/2?")
             continue
         if (got_kind, got_station) != (kind, station):
@@ -238,14 +211,14 @@ def _check_d(outcomes, calls):
                 hint = "; the right place, another kind"
             elif got_kind == "none":
                 hint = "; an effect is there: compare the misfit drop with 20 sigma^2/2 (sigma = noise)"
-            fb.append(f"[{call.label}] expected {kind} at mass {station}, got {got_kind} at mass "
+            fb.append(f"{tag} expected {kind} at mass {station}, got {got_kind} at mass "
                       f"{got_station}{hint}")
             continue
         score += per * 2 / 3
         if abs(x[2] - size) <= RTOL_SIZE * abs(size):
             score += per / 3
         else:
-            fb.append(f"[{call.label}] {kind} at mass {station} is right; size: expected {fmt(size)} within "
+            fb.append(f"{tag} {kind} at mass {station} is right; size: expected {fmt(size)} within "
                       f"10 %, got {fmt(x[2])}")
     if not fb:
         fb = ["correct: every hidden effect found, with its size within 10 %"]
