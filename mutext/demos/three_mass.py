@@ -140,7 +140,7 @@ def run(args) -> int:
     if args.frf:                # the user's own data: no known difference to compare K with
         r.update({"Du": None, "K_rel_error": None, "K_rel_error_unweighted": None, "Du_spread": None})
     if args.json:
-        from ..cli import print_json
+        from ..jsonio import print_json
         print_json({k: r[k] for k in ("trial", "mu", "mu_lower", "Wz", "fit", "fit_sigma", "fit_residual", "Du", "K_rel_error", "K_rel_error_unweighted",
                                       "Du_spread", "Wz_floor", "measured_fit", "controller_order", "tries", "thesis", "band_rad_s", "seconds")})
         return 0

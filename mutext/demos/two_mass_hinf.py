@@ -11,7 +11,6 @@ import os
 import sys
 import time
 
-import numpy as np
 
 from ..examples import two_mass
 from ..hinf import hinfsyn, slycot_hinfsyn
@@ -64,7 +63,7 @@ def run(args) -> int:
     out = solve(params)
     res = out["result"]
     if args.json:
-        from ..cli import print_json
+        from ..jsonio import print_json
         print_json({k: out[k] for k in ("gamma", "gamma_slycot", "closed_loop_hinf", "closed_loop_hinf_slycot",
                                         "closed_loop_stable", "max_closed_loop_real_part", "controller_poles",
                                         "controller_rhp_poles", "seconds", "controller_order", "gamma_thesis")})

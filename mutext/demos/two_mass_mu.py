@@ -104,7 +104,7 @@ def run(args) -> int:
           "D-K iteration:", file=sys.stderr, flush=True)
     out = solve(args.xmax, args.max_iter, out=sys.stderr)
     if args.json:
-        from ..cli import print_json
+        from ..jsonio import print_json
         print_json({k: v for k, v in out.items() if k != "result"})
         return 0
     thesis = out["mu_thesis"]

@@ -41,7 +41,7 @@ def _peaks(f, mag):
 
 def solve(model_path=None, *, n_modes=6, points=400, band=(20.0, 225.0)):
     """Everything the demo reports, as a dict (SI; frequencies in Hz)."""
-    from . import data_path, load_model
+    from ..rotor import data_path, load_model
     t0 = time.perf_counter()
     model_path = model_path or data_path("rotor.toml")
     rotors = {"healthy": load_model(model_path),
@@ -71,7 +71,7 @@ def solve(model_path=None, *, n_modes=6, points=400, band=(20.0, 225.0)):
 def run(args) -> int:
     out = solve(args.model, n_modes=args.modes, points=args.points)
     if args.json:
-        from ..cli import print_json
+        from ..jsonio import print_json
         keys = ("natural_frequencies_hz", "whirl", "frf_peaks_hz", "frf_antiresonances_hz", "speed_rpm",
                 "bearing_stiffness_n_per_m", "force_per_ampere_n_per_a", "note", "assumptions", "seconds")
         print_json({k: out[k] for k in keys})
