@@ -2,10 +2,10 @@
 from __future__ import annotations
 
 import argparse
-import json
 import sys
 
 from .errors import MutextError
+from .jsonio import print_json  # noqa: F401  (kept importable from here)
 
 # name -> (module, one-line description); modules expose add_arguments(parser) and run(args) -> int
 DEMOS = {
@@ -17,7 +17,7 @@ DEMOS = {
                     "two-mass mu-synthesis, +/-2 % on m1, m2, k1, k2 (thesis sec. 2.3.2): D-K iteration, checked controller"),
     "three-mass": ("mutext.demos.three_mass",
                    "model-based identification on the three-mass rig (thesis sec. 3.4): unmodeled dynamics as a mu-controller"),
-    "rotor": ("mutext.rotor.demo",
+    "rotor": ("mutext.demos.rotor",
               "rotor finite-element model: natural frequencies of the healthy and cracked rotor, exciter FRF"),
 }
 
@@ -114,19 +114,6 @@ def main(argv=None) -> int:
         return 0
     print(f"mutext: unknown command '{cmd}' (expected one of diagnose, rig, demo, grade)", file=sys.stderr)
     return 2
-
-
-def print_json(obj) -> None:
-    """Print one JSON object (numpy scalars and arrays converted)."""
-    import numpy as np
-
-    def conv(o):
-        if isinstance(o, np.ndarray):
-            return o.tolist()
-        if isinstance(o, (np.floating, np.integer)):
-            return o.item()
-        raise TypeError(f"not JSON serializable: {type(o).__name__}")
-    print(json.dumps(obj, default=conv))
 
 
 if __name__ == "__main__":  # pragma: no cover

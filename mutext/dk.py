@@ -73,7 +73,6 @@ References
 """
 from __future__ import annotations
 
-import sys
 import time
 from dataclasses import dataclass, field
 
@@ -874,7 +873,7 @@ def dk_iteration(P, structure: BlockStructure, nmeas: int, ncon: int, *, omega=N
                  max_iter: int = 8, max_order: int = 4, max_states: int | None = None,
                  fit_tol: float = 0.02, rel_improvement: float = 0.01, patience: int = 1,
                  grid_points: int = 80, final_points: int = 200, dg: bool = True,
-                 synthesis=None, out=sys.stdout) -> DKResult:
+                 synthesis=None, out=None) -> DKResult:
     r"""D-K iteration for robust performance.
 
     Parameters
@@ -922,7 +921,7 @@ def dk_iteration(P, structure: BlockStructure, nmeas: int, ncon: int, *, omega=N
         callable ``synthesis(PD, nmeas, ncon)`` must return an object with
         ``K`` and ``gamma``.
     out : file or None
-        Where the per-iteration table is printed (None: silent).
+        Where the per-iteration table is printed (default None: silent; the demos pass sys.stderr).
 
     Returns
     -------

@@ -46,7 +46,6 @@ References
 """
 from __future__ import annotations
 
-import sys
 import time
 from dataclasses import dataclass, field
 
@@ -609,7 +608,7 @@ def _source(frf) -> str:
 def identify(true, engineering, *, excitation: str, measurement: str, control_input: str,
              control_output: str, Ww: float = 1.0, Wz: float | None = None, tol: float = 0.05,
              max_tries: int = 8, regularization: float | None = 1e-4, omega=None,
-             dk_options: dict | None = None, out=sys.stdout) -> MBIResult:
+             dk_options: dict | None = None, out=None) -> MBIResult:
     r"""Identify the unmodeled dynamics of ``engineering`` by mu-synthesis (thesis sec. 3.5).
 
     Runs D-K iteration on the plant of :func:`mbi_plant` and tunes :math:`W_z`
@@ -642,7 +641,7 @@ def identify(true, engineering, *, excitation: str, measurement: str, control_in
     dk_options : dict, optional
         Passed to :func:`mutext.dk.dk_iteration`.
     out : file or None
-        Progress (one line per try, and the D-K tables); None for silence.
+        Progress (one line per try, and the D-K tables); default None: silent (the demos pass a stream).
 
     Returns
     -------

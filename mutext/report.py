@@ -6,36 +6,18 @@ figures come from :func:`mutext.plots.diagnosis_figures`.
 from __future__ import annotations
 
 import html
-import json
 import os
 
-import numpy as np
-
 from .diagnose import Diagnosis, write_model
+from .jsonio import to_json as _to_json
 from .plots import diagnosis_figures
 
 __all__ = ["write_diagnosis", "to_json"]
 
 
-def _conv(o):
-    if isinstance(o, np.ndarray):
-        return o.tolist()
-    if isinstance(o, (np.floating, np.integer, np.bool_)):
-        return o.item()
-    raise TypeError(f"not JSON serializable: {type(o).__name__}")
-
-
 def to_json(result: Diagnosis) -> str:
-    """The diagnosis as one JSON object (infinite numbers as strings ``"inf"``)."""
-    def clean(x):
-        if isinstance(x, float) and not np.isfinite(x):
-            return str(x)
-        if isinstance(x, dict):
-            return {k: clean(v) for k, v in x.items()}
-        if isinstance(x, list):
-            return [clean(v) for v in x]
-        return x
-    return json.dumps(clean(result.as_dict()), default=_conv)
+    """The diagnosis as one JSON object (non-finite numbers as strings ``"inf"``, ``"nan"``)."""
+    return _to_json(result.as_dict())
 
 
 def write_diagnosis(result: Diagnosis, out_dir) -> dict:
