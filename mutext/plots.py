@@ -308,7 +308,7 @@ def mbi_figure(result, true_systems, Du=None, title=None):
             if Du is not None:
                 a.semilogx(w, np.degrees(np.unwrap(np.angle(impedance_response(Du, w)))), "k:", label="$D_u$")
             a.set_ylabel("phase [deg]")
-            a.set_title("(c) phase of K and $D_u$")
+            a.set_title("(c) phase of K" + (" and $D_u$" if Du is not None else ""))
     a = ax[1, 1]
     for k, T in enumerate(true_systems):
         a.loglog(w, result.error(T), color="C0", alpha=0.6, lw=1, label="true samples" if k == 0 else None)
@@ -316,9 +316,11 @@ def mbi_figure(result, true_systems, Du=None, title=None):
     a.set_ylabel(r"$|x_t - x_e|$ per unit input")
     a.set_title("(d) error of the controlled model")
     a.legend(fontsize=8)
+    from matplotlib.ticker import NullFormatter
     for a in ax.ravel():
         a.set_xlabel("frequency [rad/s]")
         a.grid(True, which="both", alpha=0.3)
+        a.xaxis.set_minor_formatter(NullFormatter())     # a band of under two decades labels its minor ticks
     if title:
         fig.suptitle(title)
     fig.tight_layout()

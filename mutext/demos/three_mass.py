@@ -89,7 +89,7 @@ def figure(r, samples: int = 8):
         fit = r["result"].measured_fit.system
         from ..lti import ss
         trues = [ss(fit.A, fit.B, fit.C, fit.D, inputs=["f1"], outputs=["x1"])]
-        return plots.mbi_figure(r["result"], trues, Du=tr.Du, title=f"three-mass trial {tr.name}, measured")
+        return plots.mbi_figure(r["result"], trues, Du=r["Du"], title=f"three-mass trial {tr.name}, measured")
     U = three_mass.true_model(tr)
     trues = [U.at(U.values(d)) for d in U.sample(samples, rng=0, vertices=True)]
     return plots.mbi_figure(r["result"], trues, Du=tr.Du, title=f"three-mass trial {tr.name}")
@@ -129,6 +129,8 @@ def run(args) -> int:
                   + ("(measured sweep)" if args.measured is not None else f"(+/-{tr.uncertainty:.0%})"))
         print("D-K iteration and W_z search (progress on stderr) ...", flush=True)
     r = solve(args.trial, out=out, measured=measured)
+    if args.frf:                # the user's own data: no known difference to compare K with
+        r.update({"Du": None, "K_rel_error": None, "K_rel_error_unweighted": None, "Du_spread": None})
     if args.plots:
         os.makedirs(args.plots, exist_ok=True)
         fig = figure(r)
@@ -137,8 +139,6 @@ def run(args) -> int:
         import matplotlib.pyplot as plt
         plt.close(fig)
         print(f"plot saved: {path}", file=sys.stderr if args.json else sys.stdout)
-    if args.frf:                # the user's own data: no known difference to compare K with
-        r.update({"Du": None, "K_rel_error": None, "K_rel_error_unweighted": None, "Du_spread": None})
     if args.json:
         from ..jsonio import print_json
         print_json({k: r[k] for k in ("trial", "mu", "mu_lower", "Wz", "fit", "fit_sigma", "fit_residual", "Du", "K_rel_error", "K_rel_error_unweighted",
