@@ -207,16 +207,18 @@ def _noise(chans, noise) -> float:
 def _data_sets(rec, allf, chans, vchans):
     """(fit, held out, all fitted channels, description of the held-out data)."""
     def data_for(cs, keep):
-        idx, meas, H0, b, fs = [], [], [], [], []
-        for c, kp in zip(cs, keep):
+        idx, meas, H0, b, fs, cols = [], [], [], [], [], {}
+        for k, (c, kp) in enumerate(zip(cs, keep)):
             pos = np.searchsorted(allf, c.frf.freq_hz[kp])
             bb = rec.input_vector(c.in_spec)
+            Rb = np.einsum("kij,j->ki", rec.R[pos], bb)        # R b at every DOF, shared by all hypotheses
+            cols[k] = (Rb, rec.R[pos, c.out_dof, :])
             idx.append(pos)
             meas.append(c.frf.response[kp])
-            H0.append(rec.R[pos][:, c.out_dof, :] @ bb)
+            H0.append(Rb[:, c.out_dof])
             b.append(bb)
             fs.append(c.frf.freq_hz[kp])
-        return _Data(list(cs), idx, meas, H0, b, fs)
+        return _Data(list(cs), idx, meas, H0, b, fs, cols)
 
     every = [np.arange(c.frf.freq_hz.size) for c in chans]
     if vchans:

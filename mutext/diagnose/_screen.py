@@ -283,12 +283,12 @@ def _separating_station(rec: _Receptance, fit: _Data, cands: list, model) -> int
         for f in cands:
             h = f.hypothesis
             hs = []
-            for ch, idx, b in zip(fit.chans, fit.idx, fit.b):
+            for k, (ch, idx, b) in enumerate(zip(fit.chans, fit.idx, fit.b)):
                 probe = _Chan(ch.frf, ch.label, ch.in_spec, ch.in_col, ch.in_name, ch.in_station, d, "probe", s,
                               ch.speed)
-                Rk = rec.R[idx]
-                H0 = Rk[:, d, :] @ b
-                data = _Data([probe], [idx], [H0], [H0], [b])
+                Rb, _ = fit.columns(rec, k)
+                H0 = Rb[:, d]
+                data = _Data([probe], [idx], [H0], [H0], [b], None, {0: (Rb, rec.R[idx, d, :])})
                 hs.append(_Evaluator(rec, data, h).responses(f.value)[0])
             resp.append(np.concatenate(hs))
         sep = min(float(np.sqrt(np.mean(np.abs(np.log(resp[i] / resp[j])) ** 2)))
