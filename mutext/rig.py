@@ -75,7 +75,7 @@ from .response import DIRECTIONS, FRF, INPUT_UNITS, OUTPUT_UNITS, sweep_frequenc
 
 __all__ = [
     "FRF", "FRFFileError", "Noise", "read_frf", "write_frf", "read_frfs", "measure",
-    "sweep_frequencies", "INPUT_UNITS", "OUTPUT_UNITS", "CSV_HEADER",
+    "sweep_frequencies", "INPUT_UNITS", "OUTPUT_UNITS", "CSV_HEADER", "measure_rotor",
     "THESIS_SWEEP_HZ", "THESIS_ANALYSIS_BAND_HZ", "THESIS_EXCITATION_A", "THESIS_SPEED_HZ",
 ]
 
@@ -305,6 +305,12 @@ def read_frf(path, *, mapping=None) -> FRF:
                output_quantity=out_q, speed_hz=speed, metadata=meta, source=path, **dirs, **port_names)
 
 
+def _breaks_line(text: str) -> bool:
+    """True if ``text`` holds a character that :meth:`str.splitlines` (the reader)
+    treats as a line break (\\n, \\r, \\v, \\f, \\x1c-\\x1e, \\x85, \\u2028, \\u2029)."""
+    return len(("x" + text + "x").splitlines()) > 1
+
+
 def write_frf(path, frf: FRF, *, output_unit: str = "m") -> Path:
     """Write an FRF in the file format of this module.
 
@@ -348,14 +354,14 @@ def write_frf(path, frf: FRF, *, output_unit: str = "m") -> Path:
     for key in ("input_name", "output_name"):
         v = getattr(frf, key)
         if v is not None:
-            if not isinstance(v, str) or not v.strip() or any(c in v for c in "\r\n"):
+            if not isinstance(v, str) or not v.strip() or _breaks_line(v):
                 raise ModelError(f"write_frf {path}: {key} {v!r} cannot be written on one header line")
             lines.append(f"# {key}: {v.strip()}")
     for k, v in frf.metadata.items():
         if k in ("file_output_unit", "file_input_unit") or k in _RESERVED:
             continue
         k, v = str(k), str(v)
-        if ":" in k or "\n" in k or "\n" in v or not k.strip():
+        if ":" in k or _breaks_line(k) or _breaks_line(v) or not k.strip() or k.strip().startswith("#"):
             raise ModelError(f"write_frf {path}: metadata key {k!r} / value {v!r} cannot be "
                              f"written as a '# key: value' line")
         lines.append(f"# {k.strip()}: {v.strip()}")
@@ -363,7 +369,10 @@ def write_frf(path, frf: FRF, *, output_unit: str = "m") -> Path:
     G = frf.response_in(output_unit)
     for f, g in zip(frf.freq_hz, G):
         lines.append(f"{float(f)!r},{float(g.real)!r},{float(g.imag)!r}")
-    path.write_text("\n".join(lines) + "\n", encoding="utf-8")
+    try:
+        path.write_text("\n".join(lines) + "\n", encoding="utf-8")
+    except OSError as exc:
+        raise FRFFileError(path, None, None, f"cannot write file: {exc.strerror or exc}") from None
     return path
 
 
@@ -561,3 +570,60 @@ def measure(system, input=0, output=0, freq_hz=None, *, noise=None, rng=None,
     return FRF(freq_hz=f, response=G, input_station=input_station, output_station=output_station,
                input_quantity=input_quantity, output_quantity=output_quantity, speed_hz=speed_hz,
                metadata=meta, input_direction=input_direction, output_direction=output_direction, **names)
+
+
+def measure_rotor(model, input: str, output: str, freq_hz=None, *, noise=None, rng=None,
+                  harmonics: int = 6, cutoff_hz: float = 1000.0, revolutions: int = 40,
+                  settle_s: float = 0.7, metadata: Mapping[str, str] | None = None) -> FRF:
+    r"""Virtual sine sweep of a finite-element rotor, as the rig's analyzer measures it.
+
+    A rotor without a breathing crack is time-invariant: the measurement is
+    its exact frequency response (:func:`mutext.rotor.analysis.frf`).  With a
+    breathing crack (``breathing = "mayes"``, ``"gasch"`` or ``"open"`` in the
+    model file) and a running speed, the rotor is time-periodic and the
+    measurement is the analyzer's correlation of the response with the
+    excitation (:func:`mutext.rotor.periodic.analyzer_frf`: harmonic balance
+    with ``harmonics`` terms either side, on the Ritz-reduced model below
+    ``cutoff_hz``; the reduction error is stored in the metadata), which
+    shows the sidebands a time-invariant model cannot hold.
+
+    Parameters
+    ----------
+    model : mutext.rotor.Rotor
+    input, output : str
+        Port names (e.g. ``"i12"``, ``"x13"``).
+    freq_hz : array_like, optional
+        Default :func:`sweep_frequencies` (20-225 Hz, 0.5 Hz).
+    noise, rng
+        As in :func:`measure`.
+    harmonics, cutoff_hz, revolutions, settle_s
+        Harmonic-balance truncation, reduction cutoff [Hz] and the analyzer's
+        correlation length and settling time (thesis: 40 revolutions, 700 ms).
+
+    Returns
+    -------
+    FRF
+        With the ports' stations, directions and quantities and the speed.
+    """
+    from .rotor.periodic import analyzer_frf, periodic_rotor
+    f = sweep_frequencies() if freq_hz is None else np.asarray(freq_hz, dtype=float).ravel()
+    pr = periodic_rotor(model, inputs=[input], outputs=[output])
+    meta = {str(k): str(v) for k, v in (metadata or {}).items()}
+    if pr.time_invariant():
+        H = model.frf(f, inputs=[input], outputs=[output])
+        meta.setdefault("analyzer", "time-invariant model: exact frequency response")
+    else:
+        red = pr.reduce(cutoff_hz, band_hz=(float(f.min()), float(f.max())))
+        H = analyzer_frf(red, f, harmonics=harmonics, revolutions=revolutions, settle_s=settle_s)
+        meta.update({"analyzer": f"stepped sine, {revolutions} revolutions per correlation, "
+                                 f"{settle_s:g} s settling; harmonic balance N = {harmonics}",
+                     "breathing": ", ".join(f"{c.name} {c.law}" for c in pr.cracks),
+                     "reduction_error": f"{red.reduction_error:.3g}"})
+    ch = H.channel(output, input)
+    meas = measure(lambda w: ch.response, 0, 0, f, noise=noise, rng=rng,
+                   input_station=ch.input_station, output_station=ch.output_station,
+                   input_quantity=ch.input_quantity, output_quantity=ch.output_quantity,
+                   speed_hz=ch.speed_hz, metadata=meta, input_direction=ch.input_direction,
+                   output_direction=ch.output_direction)
+    meas.input_name, meas.output_name = input, output
+    return meas

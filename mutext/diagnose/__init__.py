@@ -122,6 +122,8 @@ from ._core import HOLDOUT_EVERY, diagnose
 from ._extend import extended_model_text, mbi_reading, write_model
 from ._hypotheses import KINDS, Hypothesis, hypotheses
 from ._result import ChannelComparison, Diagnosis, Finding, ResonanceRow
+from ._sidebands import SidebandCandidate, SidebandEvidence, sideband_evidence
 
 __all__ = ["diagnose", "Diagnosis", "Finding", "Hypothesis", "ChannelComparison", "ResonanceRow",
-           "hypotheses", "extended_model_text", "write_model", "mbi_reading", "KINDS", "HOLDOUT_EVERY"]
+           "hypotheses", "extended_model_text", "write_model", "mbi_reading", "KINDS", "HOLDOUT_EVERY",
+           "sideband_evidence", "SidebandEvidence", "SidebandCandidate"]

@@ -83,6 +83,7 @@ __all__ = [
     "equivalent_reduced_inertia",
     "open_fraction", "rotating_frame_stiffness", "fixed_frame_stiffness",
     "JeffcottResult", "simulate_breathing_jeffcott", "Crack",
+    "BREATHING_LAWS", "breathing_weights", "breathing_fourier",
 ]
 
 #: Largest depth ratio a/D for which the strip integration is used ([Pap04]_).
@@ -592,6 +593,64 @@ def fixed_frame_stiffness(k0, dk_xi, dk_eta, theta, psi, model: str = "mayes"):
                      [-f * d * s2, k0 - f * (s - d * c2)]])
 
 
+#: Breathing laws a crack in a model file may declare (``breathing = ...``).
+BREATHING_LAWS = ("open", "mayes", "gasch")
+
+
+def breathing_weights(theta, law: str):
+    r"""Weights :math:`(g_{xx}, g_{yy}, g_{xy})` of a turning crack at shaft angle ``theta``.
+
+    A crack whose normal makes the angle :math:`\theta` with :math:`x` adds, in
+    the fixed frame,
+
+    .. math::
+        \Delta K(\theta) = f(\psi)\left[\cos^2\theta\,A_{xx} + \sin^2\theta\,A_{yy}
+        + \sin\theta\cos\theta\,A_{xy}\right],\qquad \psi = \theta + \pi/2,
+
+    where :math:`A_{xx}, A_{yy}, A_{xy}` are the changes of the fully open
+    crack facing :math:`x`, :math:`y` and the coupling (see
+    :meth:`Crack.directional_deltas`), and :math:`f` is the open fraction of
+    ``law`` (:func:`open_fraction`) under weight dominance (:math:`y` up: the
+    crack is open when its normal points down, :math:`\theta = -\pi/2`).
+    Returns the three weights :math:`f\cos^2\theta`, :math:`f\sin^2\theta`,
+    :math:`f\sin\theta\cos\theta` (arrays shaped like ``theta``).
+    """
+    if law not in BREATHING_LAWS:
+        raise ModelError(f"breathing law must be one of {BREATHING_LAWS}, got {law!r}")
+    th = np.asarray(theta, dtype=float)
+    f = open_fraction(th + np.pi / 2.0, law)
+    c, s = np.cos(th), np.sin(th)
+    return f * c * c, f * s * s, f * s * c
+
+
+def breathing_fourier(law: str, n_terms: int = 16, *, samples: int = 4096) -> np.ndarray:
+    r"""Fourier coefficients of :func:`breathing_weights` over one revolution.
+
+    Returns ``c`` of shape ``(2 n_terms + 1, 3)``: row ``n_terms + m`` holds
+    :math:`c_m = \frac{1}{2\pi}\int_0^{2\pi} g(\theta) e^{-jm\theta}\,d\theta` for
+    the three weights, so that :math:`g(\theta) = \sum_m c_m e^{jm\theta}`.
+    The Mayes law and the open crack are trigonometric polynomials (orders 3
+    and 2), so their coefficients are exact; the Gasch law switches at
+    :math:`\theta = 0, \pi` and its coefficients decay like :math:`1/m`
+    (trapezoidal rule with the jumps on samples: error :math:`O(\text{samples}^{-2})`).
+    """
+    if law not in BREATHING_LAWS:
+        raise ModelError(f"breathing law must be one of {BREATHING_LAWS}, got {law!r}")
+    if isinstance(n_terms, bool) or not isinstance(n_terms, (int, np.integer)) or n_terms < 0:
+        raise ModelError(f"n_terms must be a non-negative integer, got {n_terms!r}")
+    samples = max(int(samples), 4 * n_terms + 8)
+    samples += samples % 2                      # the jumps at 0 and pi fall on samples
+    th = 2.0 * np.pi * np.arange(samples) / samples
+    g = np.stack(breathing_weights(th, law), axis=1)
+    if law == "gasch":
+        for j in (0, samples // 2):             # the mean of both sides at a jump
+            g[j] = 0.5 * (np.stack(breathing_weights(th[j] - 1e-9, law)) +
+                          np.stack(breathing_weights(th[j] + 1e-9, law)))
+    F = np.fft.fft(g, axis=0) / samples
+    m = np.arange(-n_terms, n_terms + 1)
+    return F[m % samples]
+
+
 @dataclass
 class JeffcottResult:
     r"""Steady-state record of :func:`simulate_breathing_jeffcott`.
@@ -810,6 +869,15 @@ def _make_crack_class():
             Crack position as a fraction of the host element, in [0, 1].
         n_quad : int
             Gauss points of the compliance integral.
+        breathing : {None, "open", "mayes", "gasch"}
+            A crack that turns with the shaft (see :mod:`mutext.rotor.periodic`):
+            ``orientation`` is then the angle of the crack normal from :math:`x`
+            at :math:`t = 0`, the rotor is linear time-periodic at speed, and
+            the time-invariant model (``frf``, ``state_space``, ``modes``)
+            holds the stiffness averaged over one revolution (the
+            :math:`m = 0` term of :func:`breathing_fourier`: :math:`(A_{xx} +
+            A_{yy})/4` for ``"mayes"`` and ``"gasch"``, :math:`/2` for
+            ``"open"``).  Needs two bending planes.
         name : str, optional
             Default ``"crack<station>"``.
 
@@ -822,8 +890,15 @@ def _make_crack_class():
         FIELDS = {"depth_ratio": ("1", "crack depth over shaft diameter a/D")}
 
         def __init__(self, station: int, depth_ratio, *, orientation=0.0, xi: float = 0.0,
-                     n_quad: int = 16, name: str | None = None):
+                     n_quad: int = 16, breathing: str | None = None, name: str | None = None):
             Element.__init__(self, (station, station + 1), name, depth_ratio=depth_ratio)
+            if breathing is not None and breathing not in BREATHING_LAWS:
+                raise ModelError(f"{self.name}: breathing must be one of {', '.join(BREATHING_LAWS)}, "
+                                 f"got {breathing!r}")
+            if breathing is not None and orientation == "mean":
+                raise ModelError(f"{self.name}: a breathing crack turns with the shaft; give its angle "
+                                 "at t = 0 as orientation [rad], not 'mean'")
+            self.breathing = breathing
             d = self.nominal("depth_ratio")
             if not 0.0 <= d <= MAX_DEPTH_RATIO:
                 raise ModelError(f"{self.name}.depth_ratio must lie in [0, {MAX_DEPTH_RATIO}] "
@@ -855,7 +930,21 @@ def _make_crack_class():
             nu = h.sym(p, "nu") if h.has("nu") else E / (2.0 * h.sym(p, "G")) - 1.0
             return crack_compliance(self.sym(p, "depth_ratio"), E, D, nu, n_quad=self.n_quad)
 
+        def directional_deltas(self, p, layout):
+            r"""Local :math:`(A_{xx}, A_{yy}, A_{xy})`: the open crack facing :math:`x`, facing
+            :math:`y`, and the coupling, so that the crack at angle :math:`\beta` adds
+            :math:`\cos^2\beta A_{xx} + \sin^2\beta A_{yy} + \sin\beta\cos\beta A_{xy}`."""
+            if layout.kind != "rotor":
+                raise ModelError(f"{self.name}: a turning crack needs two bending planes (planes = 2)")
+            delta = self.plane_delta(p, self.compliance(p))
+            return (ca.mtimes([T_XZ.T, delta, T_XZ]), ca.mtimes([T_YZ.T, delta, T_YZ]),
+                    ca.mtimes([T_XZ.T, delta, T_YZ]) + ca.mtimes([T_YZ.T, delta, T_XZ]))
+
         def stiffness_matrix(self, p, layout):
+            if self.breathing is not None:
+                c0 = breathing_fourier(self.breathing, 0)[0].real
+                Axx, Ayy, Axy = self.directional_deltas(p, layout)
+                return float(c0[0]) * Axx + float(c0[1]) * Ayy + float(c0[2]) * Axy
             delta = self.plane_delta(p, self.compliance(p))
             if self.orientation == "mean":
                 if layout.kind == "plane":

@@ -1,0 +1,279 @@
+r"""Sidebands: the signature of a stiffness that turns with the shaft.
+
+A rotor whose stiffness changes within a revolution (a breathing crack, an
+asymmetric shaft) is linear time-periodic: forced at :math:`\omega` it also
+responds at :math:`\omega + k\Omega`, and the measured FRF resonates where
+:math:`\omega + k\Omega` meets a natural frequency, i.e. at
+
+.. math::
+    f = f_n - k F, \qquad k = \pm 1, \pm 2, \pm 3, \qquad F = \Omega / 2\pi,
+
+a small copy of the mode's resonance shifted by :math:`kF`.  No
+time-invariant model has a resonance there.  :math:`|k| = 1` (and 3) comes
+from a stiffness that changes once per turn (the crack opening under
+weight), :math:`|k| = 2` from one that changes twice per turn (an open crack
+or any asymmetric shaft seen from the fixed frame).
+
+**The test** (one candidate :math:`f_c = f_n - kF` at a time, on the data
+alone): in a window around :math:`f_c` the measured response is fitted by
+weighted linear least squares with a smooth baseline (a constant, a slope,
+and the resonance shape of every nearby mode),
+
+.. math::
+    H(f) \approx c_0 + c_1 (f - f_c) + \sum_j b_j L(f; f_j, \zeta_j)
+    \quad [+\; a\,L(f + kF; f_n, \zeta_n)],\qquad
+    L(f; f_n, \zeta) = \frac{1}{f_n^2 - f^2 + 2j\zeta f_n f},
+
+with and without the shifted resonance :math:`a\,L(f + kF)`.  With
+circular complex noise of relative size :math:`\sigma` (estimated from the
+data, :func:`mutext.frfit.noise_level`), the drop of the weighted residual
+:math:`\Delta\chi^2` is :math:`\chi^2` with 2 degrees of freedom per channel
+when there is no sideband.  A candidate is found when its p-value is below
+``alpha`` divided by the number of candidates (Bonferroni).  The mode
+frequencies and damping come from the data (each mode fitted by its own
+resonance shape near the given natural frequency), so the model is only
+used to say where to look.
+
+A candidate closer to a mode than three half-power bandwidths is masked by
+the mode itself and reported as such, not tested.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+from scipy import stats
+
+from ..errors import ModelError
+
+__all__ = ["SidebandCandidate", "SidebandEvidence", "sideband_evidence"]
+
+
+@dataclass
+class SidebandCandidate:
+    """One place where a sideband of order ``k`` of the mode at ``mode_hz`` would appear."""
+    mode_hz: float
+    k: int
+    freq_hz: float
+    delta_chi2: float = float("nan")
+    p_value: float = float("nan")
+    relative_size: float = float("nan")
+    snr: float = float("nan")
+    found: bool = False
+    masked: bool = False
+
+    def to_dict(self) -> dict:
+        return dict(self.__dict__)
+
+
+@dataclass
+class SidebandEvidence:
+    """Result of :func:`sideband_evidence`.
+
+    Attributes
+    ----------
+    candidates : list of SidebandCandidate
+    modes : list of (frequency [Hz], damping ratio)
+        The modes as fitted on the data.
+    speed_hz : float
+    noise : float
+        Relative noise level used.
+    threshold : float
+        p-value below which a candidate counts (alpha / number tested).
+    orders_found : list of int
+        The orders :math:`|k|` with at least one sideband found.
+    verdict : str
+        ``"once per revolution"`` (|k| = 1 or 3 found: a breathing crack),
+        ``"twice per revolution"`` (only |k| = 2: an open crack or asymmetric
+        shaft), or ``"none"`` (a time-invariant model explains the data).
+    detectable : float
+        The smallest sideband (relative to the local response) this noise
+        level lets the test see, roughly.
+    """
+    candidates: list
+    modes: list
+    speed_hz: float
+    noise: float
+    threshold: float
+    orders_found: list = field(default_factory=list)
+    verdict: str = "none"
+    detectable: float = float("nan")
+
+    def found(self) -> list:
+        return [c for c in self.candidates if c.found]
+
+    def summary(self) -> str:
+        lines = [f"sidebands at {self.speed_hz:g} Hz running speed (noise {100 * self.noise:.3g} %, "
+                 f"threshold p < {self.threshold:.2g}): {self.verdict}"]
+        for c in self.candidates:
+            if c.masked:
+                continue
+            mark = "FOUND" if c.found else "-"
+            lines.append(f"  mode {c.mode_hz:8.2f} Hz  k={c.k:+d}  at {c.freq_hz:8.2f} Hz  "
+                         f"size {100 * c.relative_size:7.3f} %  dchi2 {c.delta_chi2:9.1f}  p {c.p_value:9.2e}  {mark}")
+        return "\n".join(lines)
+
+    def to_dict(self) -> dict:
+        return {"speed_hz": self.speed_hz, "noise": self.noise, "threshold": self.threshold,
+                "verdict": self.verdict, "orders_found": list(self.orders_found),
+                "detectable": self.detectable, "modes": [list(m) for m in self.modes],
+                "candidates": [c.to_dict() for c in self.candidates]}
+
+
+def _shape(f, fn, zeta):
+    return 1.0 / (fn * fn - f * f + 2j * zeta * fn * f)
+
+
+def _data_modes(f, H, noise, clusters, reach):
+    """(frequency, damping) of each given mode, read from the data by vector fitting.
+
+    Each cluster of given natural frequencies is matched to the fitted
+    resonances within 3 % (all of them, so that close modes stay apart); a
+    mode outside the band, or not found, keeps its given frequency and 1 %
+    damping.  Modes further than ``reach`` outside the band are dropped.
+    """
+    from ..frfit import resonances
+    try:
+        res = resonances(f, H, noise=noise, n_boot=0)
+    except Exception:           # noqa: BLE001 - a failed fit leaves the given frequencies
+        res = []
+    modes = []
+    for c in clusters:
+        fn0 = float(np.mean(c))
+        if not (f.min() - reach <= fn0 <= f.max() + reach):
+            continue
+        near = [r for r in res if abs(r.freq_hz - fn0) <= 0.03 * fn0 + 0.5 * (max(c) - min(c))]
+        if near and f.min() <= fn0 <= f.max():
+            near = sorted(near, key=lambda r: abs(r.freq_hz - fn0))[:len(c)]
+            modes.extend((float(r.freq_hz), float(r.damping_ratio)) for r in near)
+        else:
+            modes.append((fn0, 0.01))
+    return sorted(set(modes))
+
+
+def _as_list(frfs):
+    from ..response import FRF
+    if isinstance(frfs, FRF):
+        return [frfs]
+    out = list(frfs)
+    if not out or not all(isinstance(x, FRF) for x in out):
+        raise ModelError("sideband_evidence: give one FRF or a list of FRFs (mutext.rig.FRF)")
+    return out
+
+
+def sideband_evidence(frfs, natural_frequencies_hz, speed_hz: float, *, orders=(1, 2, 3),
+                      noise: float | None = None, alpha: float = 0.01) -> SidebandEvidence:
+    r"""Evidence for sidebands :math:`f_n - kF` in measured FRFs (module docstring).
+
+    Parameters
+    ----------
+    frfs : FRF or list of FRF
+        Measured at the running speed, on one frequency grid (several
+        channels add their evidence).
+    natural_frequencies_hz : sequence of float
+        Where the modes are (the model's natural frequencies are good
+        enough: each is refined on the data within 3 %).  Modes outside the
+        band widened by the largest shift are ignored.
+    speed_hz : float
+        Running speed :math:`F` [Hz].
+    orders : sequence of int
+        The :math:`|k|` to look for.
+    noise : float, optional
+        Relative noise level (default: estimated from the data).
+    alpha : float
+        False-alarm probability over all candidates.
+
+    Returns
+    -------
+    SidebandEvidence
+    """
+    from ..frfit import noise_level
+    data = _as_list(frfs)
+    f = np.asarray(data[0].freq_hz, float)
+    for d in data[1:]:
+        if d.freq_hz.shape != f.shape or not np.allclose(d.freq_hz, f, rtol=1e-9, atol=0):
+            raise ModelError("sideband_evidence: every FRF must share one frequency grid")
+    if not (np.isfinite(speed_hz) and speed_hz > 0):
+        raise ModelError(f"sideband_evidence: speed_hz must be a positive running speed [Hz], got {speed_hz!r}")
+    orders = sorted({int(abs(k)) for k in orders})
+    if not orders or orders[0] < 1:
+        raise ModelError(f"sideband_evidence: orders must be positive integers, got {orders!r}")
+    if not (0 < alpha < 1):
+        raise ModelError(f"sideband_evidence: alpha must lie in (0, 1), got {alpha!r}")
+    if f.size < 20:
+        raise ModelError(f"sideband_evidence: need at least 20 frequencies, got {f.size}")
+    Hs = [np.asarray(d.response, complex) for d in data]
+    if noise is None:
+        noise = float(np.median([noise_level(f, H) for H in Hs]))
+    noise = max(float(noise), 1e-12)
+    df = float(np.median(np.diff(f)))
+    F = float(speed_hz)
+    # the modes, refined on the data (the largest channel)
+    fn_in = np.sort(np.asarray(natural_frequencies_hz, float).ravel())
+    fn_in = fn_in[np.isfinite(fn_in) & (fn_in > 0)]
+    clusters = []
+    for x in fn_in:
+        if clusters and x - clusters[-1][-1] < 0.01 * x:
+            clusters[-1].append(x)
+        else:
+            clusters.append([x])
+    ref = Hs[int(np.argmax([np.max(np.abs(H)) for H in Hs]))]
+    modes = _data_modes(f, ref, noise, clusters, F * max(orders))
+    cands = []
+    for fn, z in modes:
+        for k in orders:
+            for kk in (k, -k):
+                fc = fn - kk * F
+                if not (f.min() < fc < f.max()):
+                    continue
+                c = SidebandCandidate(float(fn), int(kk), float(fc))
+                # masked by a mode of its own frequency (within 3 half-power bandwidths, or 3 samples)
+                c.masked = any(abs(fc - fm) < max(3.0 * zm * fm, 3 * df) for fm, zm in modes)
+                cands.append(c)
+    tested = [c for c in cands if not c.masked]
+    threshold = alpha / max(len(tested), 1)
+    for c in tested:
+        zn = dict(modes)[c.mode_hz]
+        half = max(2.5, 4.0 * zn * c.mode_hz, 6 * df)
+        sel = (f >= c.freq_hz - half) & (f <= c.freq_hz + half)
+        if sel.sum() < 8:
+            c.masked = True
+            continue
+        fs = f[sel]
+        base = [np.ones_like(fs), fs - c.freq_hz]
+        for fm, zm in modes:
+            if abs(fm - c.freq_hz) < half + 40 * zm * fm + 3 * F:
+                # the shape and its derivatives in f_n and zeta: small errors of the mode's
+                # parameters are absorbed linearly instead of being read as a sideband
+                Dn = fm * fm - fs * fs + 2j * zm * fm * fs
+                base += [1.0 / Dn, (2 * fm + 2j * zm * fs) / Dn**2, (2j * fm * fs) / Dn**2]
+        side = _shape(fs + c.k * F, c.mode_hz, zn)
+        # other candidates whose sideband falls in this window stay in both fits, so that a
+        # strong neighbour is not read as this one (a drop-one test)
+        zmap = dict(modes)
+        base += [_shape(fs + o.k * F, o.mode_hz, zmap[o.mode_hz]) for o in cands
+                 if o is not c and abs(o.freq_hz - c.freq_hz) < half and abs(o.freq_hz - c.freq_hz) > 2 * df]
+        d2, sizes = 0.0, []
+        for H in Hs:
+            y = H[sel]
+            wt = 1.0 / (noise * np.maximum(np.abs(y), 1e-300))     # sigma_i = noise * |H_i|
+            X0 = np.column_stack(base) * wt[:, None]
+            X1 = np.column_stack(base + [side]) * wt[:, None]
+            r0 = y * wt - X0 @ np.linalg.lstsq(X0, y * wt, rcond=None)[0]
+            coef1 = np.linalg.lstsq(X1, y * wt, rcond=None)[0]
+            r1 = y * wt - X1 @ coef1
+            # circular complex noise: |n|^2 / (sigma^2 / 2) is chi-square with 2 degrees of freedom
+            d2 += 2.0 * float(np.sum(np.abs(r0) ** 2) - np.sum(np.abs(r1) ** 2))
+            sizes.append(float(np.max(np.abs(coef1[-1] * side) / np.maximum(np.abs(y), 1e-300))))
+        c.delta_chi2 = d2
+        c.p_value = float(stats.chi2.sf(max(d2, 0.0), 2 * len(Hs)))
+        c.relative_size = float(max(sizes))
+        c.snr = c.relative_size / noise
+        c.found = bool(c.p_value < threshold)
+    found = sorted({abs(c.k) for c in cands if c.found})
+    verdict = ("once per revolution" if (1 in found or 3 in found) else
+               "twice per revolution" if 2 in found else "none")
+    n_win = max(8, int(round(2 * 2.5 / df)))
+    detectable = noise * float(np.sqrt(stats.chi2.isf(threshold, 2) / n_win)) * 2.0
+    return SidebandEvidence(cands, [(float(a), float(b)) for a, b in modes], F, noise, threshold, found,
+                            verdict, detectable)

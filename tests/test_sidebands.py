@@ -1,0 +1,79 @@
+"""Sideband evidence (mutext.diagnose.sideband_evidence) on rotor sweeps at 10 Hz.
+
+The data are the analyzer's FRFs of the finite-element rotor (harmonic balance,
+checked against time integration in test_periodic.py); the detector only
+receives the sweep, the healthy model's natural frequencies and the speed.
+"""
+import numpy as np
+import pytest
+
+from mutext.diagnose import sideband_evidence
+from mutext.errors import ModelError
+from mutext.rig import measure_rotor
+from mutext.rotor import data_path, loads_model
+
+TEXT = open(data_path("rotor.toml")).read()
+SPEED_HZ = 10.0
+NOISE = 5e-4
+
+
+def rotor(extra="", text=TEXT):
+    return loads_model(text + extra, base_dir=data_path(""))
+
+
+def crack(law):
+    return rotor(f"[[crack]]\nstation = 15\ndepth_ratio = 0.4\nbreathing = '{law}'\n")
+
+
+@pytest.fixture(scope="module")
+def modes():
+    return rotor().natural_frequencies(n=6)
+
+
+def sweep(model, seed=3, noise=NOISE):
+    return measure_rotor(model, "i12", "x13", noise=noise, rng=seed)
+
+
+def test_breathing_crack_shows_once_per_revolution_sidebands(modes):
+    ev = sideband_evidence(sweep(crack("mayes")), modes, SPEED_HZ)
+    assert ev.verdict == "once per revolution"
+    found = {(round(c.mode_hz), c.k): c for c in ev.found()}
+    # the first mode's k = +-1 sidebands, at f_n -+ 10 Hz, where predicted
+    first = min(m for m, _ in ev.modes)
+    for k in (1, -1):
+        c = found[(round(first), k)]
+        assert c.freq_hz == pytest.approx(first - k * SPEED_HZ)
+        assert c.relative_size > 3 * NOISE
+    assert ev.noise == pytest.approx(NOISE, rel=0.3)
+    assert "FOUND" in ev.summary()
+
+
+def test_open_crack_shows_twice_per_revolution_only(modes):
+    ev = sideband_evidence(sweep(crack("open")), modes, SPEED_HZ)
+    assert ev.verdict == "twice per revolution"
+    assert ev.orders_found == [2]
+
+
+@pytest.mark.parametrize("case", ["healthy", "bearing"])
+@pytest.mark.parametrize("seed", [1, 2])
+def test_time_invariant_changes_show_none(modes, case, seed):
+    model = rotor() if case == "healthy" else rotor(text=TEXT.replace("stiffness = 1.0e7", "stiffness = 0.8e7", 1))
+    ev = sideband_evidence(sweep(model, seed), modes, SPEED_HZ)
+    assert ev.verdict == "none", ev.summary()
+    assert not ev.found()
+
+
+def test_noise_above_the_sidebands_is_reported_not_guessed(modes):
+    ev = sideband_evidence(sweep(crack("mayes"), noise=0.01), modes, SPEED_HZ)
+    assert ev.detectable > 0.01
+    assert ev.verdict in ("none", "once per revolution")
+
+
+def test_bad_input(modes):
+    d = sweep(rotor())
+    with pytest.raises(ModelError, match="speed"):
+        sideband_evidence(d, modes, 0.0)
+    with pytest.raises(ModelError, match="FRF"):
+        sideband_evidence([], modes, SPEED_HZ)
+    with pytest.raises(ModelError, match="alpha"):
+        sideband_evidence(d, modes, SPEED_HZ, alpha=2.0)
