@@ -19,6 +19,8 @@ DEMOS = {
                    "model-based identification on the three-mass rig (thesis sec. 3.4): unmodeled dynamics as a mu-controller"),
     "rotor": ("mutext.demos.rotor",
               "rotor finite-element model: natural frequencies of the healthy and cracked rotor, exciter FRF"),
+    "crack": ("mutext.demos.crack",
+              "cracked rotor at speed (thesis ch. 4): breathing-crack sweep, sidebands, identification at the crack"),
 }
 
 

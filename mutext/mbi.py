@@ -57,7 +57,7 @@ from .lti import as_ss, check_finite, freqresp, is_stable, lft_lower, ss
 from .mu import Block, BlockStructure
 
 __all__ = ["MBIPlant", "mbi_plant", "ImpedanceFit", "fit_impedance", "WzTry", "MBIResult", "identify",
-           "WzFloor", "wz_floor", "true_from_frf"]
+           "WzFloor", "wz_floor", "true_from_frf", "required_impedance"]
 
 
 def _index(sys, name, kind, what):
@@ -790,3 +790,45 @@ def relative_error(K, reference, omega, weight=None) -> float:
     Kj = np.asarray(K, complex) if isinstance(K, np.ndarray) else freqresp(as_ss(K), omega)[0, 0]
     w2 = np.ones_like(omega) if weight is None else np.asarray(weight, float) ** 2
     return float(np.sqrt(np.sum(w2 * np.abs(Kj - D) ** 2 / np.abs(D) ** 2) / np.sum(w2)))
+
+
+def required_impedance(engineering, frf, *, excitation: str, measurement: str, control_input: str,
+                       control_output: str) -> np.ndarray:
+    r"""The dynamic stiffness a controller at one port must realise to reproduce a measured FRF exactly.
+
+    With the engineering responses :math:`a = H_{me}`, :math:`b = H_{mu}`,
+    :math:`c = H_{ye}`, :math:`e = H_{yu}` (measurement/control output per
+    excitation/control input) and a dynamic stiffness :math:`D` added at the
+    control port (force :math:`-D\,y`), the measured response is
+    :math:`H = a - D\,bc/(1 + De)`, so
+
+    .. math::
+        D(\omega) = \frac{a - H}{He - ae + bc}.
+
+    This is the :math:`D_u` that :func:`identify`'s controller approximates
+    (:math:`K \approx D_u`), frequency by frequency, without any fit.  Where
+    :math:`bc - (a - H)e` vanishes (the port does not move in the mode that
+    changed) no finite :math:`D` exists and the value grows without bound:
+    the port cannot explain the data there.
+
+    Parameters
+    ----------
+    engineering : control.StateSpace
+        With the four named ports.
+    frf : mutext.rig.FRF
+        The measured response from ``excitation`` to ``measurement`` (SI).
+
+    Returns
+    -------
+    ndarray (complex)
+        :math:`D` [N/m] at ``frf.freq_hz``.
+    """
+    E = as_ss(engineering, "engineering model")
+    ie = _index(E, excitation, "input", "engineering model")
+    iu = _index(E, control_input, "input", "engineering model")
+    oe = _index(E, measurement, "output", "engineering model")
+    oy = _index(E, control_output, "output", "engineering model")
+    H = np.asarray(frf.response, complex)
+    G = freqresp(E, 2 * np.pi * np.asarray(frf.freq_hz, float))
+    a, b, c, e = G[oe, ie], G[oe, iu], G[oy, ie], G[oy, iu]
+    return (a - H) / (H * e - a * e + b * c)

@@ -102,9 +102,21 @@ class SidebandEvidence:
     def found(self) -> list:
         return [c for c in self.candidates if c.found]
 
+    def meaning(self) -> str:
+        """What the verdict says about the rotor, in words."""
+        if self.verdict == "once per revolution":
+            return ("a stiffness that changes once per turn: a crack opening and closing under the "
+                    "shaft's weight (breathing)")
+        if self.verdict == "twice per revolution":
+            return ("a stiffness that changes twice per turn only: an asymmetric shaft (an open crack, a "
+                    "keyway), or a breathing crack whose 1X sidebands stay below the noise "
+                    f"(about {100 * self.detectable:.2g} % here)")
+        return ("no sidebands above the noise (smallest detectable about "
+                f"{100 * self.detectable:.2g} % of the response): a time-invariant model explains the data")
+
     def summary(self) -> str:
         lines = [f"sidebands at {self.speed_hz:g} Hz running speed (noise {100 * self.noise:.3g} %, "
-                 f"threshold p < {self.threshold:.2g}): {self.verdict}"]
+                 f"threshold p < {self.threshold:.2g}): {self.verdict}: {self.meaning()}"]
         for c in self.candidates:
             if c.masked:
                 continue
@@ -115,7 +127,7 @@ class SidebandEvidence:
 
     def to_dict(self) -> dict:
         return {"speed_hz": self.speed_hz, "noise": self.noise, "threshold": self.threshold,
-                "verdict": self.verdict, "orders_found": list(self.orders_found),
+                "verdict": self.verdict, "meaning": self.meaning(), "orders_found": list(self.orders_found),
                 "detectable": self.detectable, "modes": [list(m) for m in self.modes],
                 "candidates": [c.to_dict() for c in self.candidates]}
 
