@@ -77,3 +77,19 @@ def test_bad_input(modes):
         sideband_evidence([], modes, SPEED_HZ)
     with pytest.raises(ModelError, match="alpha"):
         sideband_evidence(d, modes, SPEED_HZ, alpha=2.0)
+
+
+def test_diagnose_reports_sidebands_for_data_taken_at_speed():
+    # a breathing crack: the diagnosis names the crack's place and the sidebands say it breathes
+    from mutext.diagnose import diagnose
+    d = sweep(crack("mayes"), seed=5, noise=1e-3)
+    res = diagnose(data_path("rotor.toml"), [d], refit=1,
+                   only=lambda h: h.kind in ("crack", "stiffness") and h.station in (5, 15, 24))
+    assert res.verdict.kind == "crack" and res.verdict.station == 15
+    assert res.sidebands["verdict"] == "once per revolution"
+    assert "sidebands" in res.report() and res.as_dict()["sidebands"]["orders_found"]
+    # a bearing change at speed: no sidebands
+    bear = rotor(text=TEXT.replace("stiffness = 1.0e7", "stiffness = 0.8e7", 1))
+    res = diagnose(data_path("rotor.toml"), [sweep(bear, seed=6, noise=1e-3)], refit=1,
+                   only=lambda h: h.kind in ("crack", "bearing", "stiffness") and h.station in (2, 15))
+    assert res.sidebands["verdict"] == "none"

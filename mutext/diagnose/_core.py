@@ -141,6 +141,8 @@ def diagnose(model, frfs, validate=None, *, alpha: float = 0.01, refit: int = 3,
     result = Diagnosis(eng.name, path, noise, findings, verdict, ambiguous, sensor, err_before, err_after, gain,
                        held_desc, comps, rows, summary, threshold, alpha, len(hyps), text,
                        time.perf_counter() - t0, notes, N)
+    if speed > 0 and hasattr(eng, "n_stations"):
+        result.sidebands = _sidebands(eng, speed, chans, verdict, result.notes)
     if mbi and verdict is not none:
         tell("model-based identification at the finding (D-K iteration)", 0.97)
         try:
@@ -153,6 +155,25 @@ def diagnose(model, frfs, validate=None, *, alpha: float = 0.01, refit: int = 3,
         write_model(result, out_dir)
     tell("done", 1.0)
     return result
+
+
+def _sidebands(eng, speed, chans, verdict, notes):
+    """Sideband evidence on the channels that share the first one's grid (data taken at speed)."""
+    from ._sidebands import sideband_evidence
+    f0 = chans[0].frf.freq_hz
+    same = [c.frf for c in chans if c.frf.freq_hz.shape == f0.shape and np.allclose(c.frf.freq_hz, f0)]
+    fm, _ = _model_modes(eng, speed)
+    try:
+        ev = sideband_evidence(same, fm, speed / (2 * math.pi))
+    except ModelError as exc:
+        notes.append(f"sideband evidence not computed: {exc}")
+        return None
+    if ev.verdict != "none":
+        notes.append(f"the data show sidebands ({ev.verdict}): the rotor is time-periodic, which no "
+                     f"time-invariant hypothesis above can hold; {ev.meaning()}"
+                     + (". The crack finding describes its stiffness averaged over a revolution"
+                        if verdict.kind == "crack" else ""))
+    return ev.to_dict()
 
 
 def _inputs(model, frfs, validate, alpha):

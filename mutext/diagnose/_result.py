@@ -119,6 +119,7 @@ class Diagnosis:
     n_residuals: int = 0          # real residuals of the fit (2 per complex point)
     extended_model: str | None = None
     mbi: dict | None = None
+    sidebands: dict | None = None   # sideband evidence when the data were taken at speed (rotors)
 
     def as_dict(self) -> dict:
         return {
@@ -136,6 +137,7 @@ class Diagnosis:
             "n_residuals": self.n_residuals,
             "extended_model": self.extended_model,
             "mbi": self.mbi,
+            "sidebands": self.sidebands,
             "notes": self.notes,
             "seconds": self.seconds,
         }
@@ -200,6 +202,12 @@ class Diagnosis:
                            f"diagnosis {m['diagnosis_value']:+.4g}: "
                            + ("they agree" if m["agrees"] else "they DISAGREE (beyond 3 standard uncertainties)")
                            + f" (mu {m['mu']:.3f}, {m['seconds']:.0f} s)")
+        if self.sidebands:
+            sb = self.sidebands
+            found = [c for c in sb["candidates"] if c["found"]]
+            out.append(f"sidebands (data taken at {sb['speed_hz']:.4g} Hz): {sb['verdict']}: {sb['meaning']}"
+                       + ("" if not found else "; at " + ", ".join(
+                           f"{c['freq_hz']:.1f} Hz (k={c['k']:+d})" for c in found[:6])))
         if self.extended_model:
             out.append(f"extended model: {self.extended_model}")
         for n in self.notes:
