@@ -19,6 +19,9 @@ analysis
 reduction
     Modal truncation with static correction and balanced truncation, with
     the measured error (H-infinity norm, band error) and the a-priori bound.
+periodic
+    A breathing crack at speed: the time-periodic rotor, harmonic transfer
+    functions, the analyzer's FRF and a brute-force time integration.
 tuning
     Fitting parameters to measured FRFs (IPOPT through CasADi, exact
     sensitivities, uncertainties).

@@ -65,6 +65,10 @@ Rotor files
     [[crack]]                     # needs mutext.rotor.crack
     station = 15
     depth_ratio = 0.4
+    breathing = "mayes"           # optional ("open", "mayes", "gasch"): turns with the shaft and
+                                  # breathes under weight; orientation = its angle at t = 0 [rad].
+                                  # Time-invariant analyses use its revolution average; the
+                                  # time-periodic rotor is mutext.rotor.periodic
 
 Lumped chains
 -------------
