@@ -34,7 +34,7 @@ from pathlib import Path
 
 from .errors import ModelError
 
-__all__ = ["diagnose_batch", "find_data_sets", "SUMMARY_FIELDS"]
+__all__ = ["SUMMARY_FIELDS", "check_jobs", "diagnose_batch", "find_data_sets", "run_parallel"]
 
 #: Columns of ``summary.csv``.
 SUMMARY_FIELDS = ("data_set", "status", "kind", "station", "element", "value", "unit", "std", "gain",
@@ -63,6 +63,7 @@ def _files(folder: Path) -> list[str]:
 def _one(folder: str, out_name: str, mbi: bool) -> dict:
     """Diagnose one data set and write its report; never raises (failures are rows too)."""
     from threadpoolctl import threadpool_limits
+
     from .diagnose import diagnose
     from .report import write_diagnosis
     d = Path(folder)
@@ -94,6 +95,46 @@ def _one(folder: str, out_name: str, mbi: bool) -> dict:
     return row
 
 
+def check_jobs(jobs, what: str = "batch") -> int:
+    """``jobs`` if it is a number of workers joblib accepts (positive, or negative for all cores but some)."""
+    if isinstance(jobs, bool) or not isinstance(jobs, int) or jobs == 0:
+        raise ModelError(f"{what}: jobs must be a positive number of workers or -1, got {jobs!r}")
+    return jobs
+
+
+def run_parallel(fn, tasks, *, jobs: int = 1, progress=None, describe=None):
+    """Yield ``fn(*task)`` for every task (a tuple of arguments), in order, on ``jobs`` joblib workers.
+
+    The engine of every batch in mutext (:func:`diagnose_batch`,
+    :func:`mutext.grading.batch.grade_batch`, ``benchmarks/bench_diagnose.py``):
+    ``jobs=1`` runs the tasks one after the other in this process; more
+    workers are joblib's processes (loky), or the workers of the active
+    joblib backend (e.g. Dask).  ``fn`` should catch its own errors and
+    return them as results; an exception raised by ``fn`` or by the pool
+    (a worker that died) ends the generator.
+
+    Parameters
+    ----------
+    fn : callable, picklable (a module-level function)
+    tasks : iterable of tuple
+    jobs : int
+    progress : callable(stage, fraction), optional
+        Called after each result.
+    describe : callable(k, n, result) -> str, optional
+        The stage text for ``progress`` (default ``"case k/n"``).
+    """
+    import joblib
+    tasks = [tuple(t) for t in tasks]
+    n = len(tasks)
+    if not n:
+        return
+    par = joblib.Parallel(n_jobs=check_jobs(jobs), return_as="generator")
+    for k, out in enumerate(par(joblib.delayed(fn)(*t) for t in tasks), start=1):
+        if progress is not None:
+            progress(describe(k, n, out) if describe is not None else f"case {k}/{n}", k / n)
+        yield out
+
+
 def diagnose_batch(root, *, jobs: int = 1, out_name: str = "diagnosis", mbi: bool = False,
                    progress=None) -> list[dict]:
     """Diagnose every data set under ``root``; write each report beside its data and a summary.
@@ -116,19 +157,14 @@ def diagnose_batch(root, *, jobs: int = 1, out_name: str = "diagnosis", mbi: boo
         One row per data set (:data:`SUMMARY_FIELDS`); also written to
         ``root/summary.csv`` and ``root/index.html``.
     """
-    import joblib
     sets = find_data_sets(root)
     if not sets:
         raise ModelError(f"batch: no data set under '{root}' (a folder with model.toml and measured/*.csv, "
                          f"as 'mutext rig hide' writes)")
-    if isinstance(jobs, bool) or not isinstance(jobs, int) or jobs == 0:
-        raise ModelError(f"batch: jobs must be a positive number of workers or -1, got {jobs!r}")
-    rows = []
-    par = joblib.Parallel(n_jobs=jobs, return_as="generator")
-    for k, row in enumerate(par(joblib.delayed(_one)(str(d), out_name, mbi) for d in sets), start=1):
-        rows.append(row)
-        if progress is not None:
-            progress(f"data set {k}/{len(sets)}: {Path(row['data_set']).name} {row['status']}", k / len(sets))
+    check_jobs(jobs)
+    rows = list(run_parallel(_one, [(str(d), out_name, mbi) for d in sets], jobs=jobs, progress=progress,
+                             describe=lambda k, n, row: f"data set {k}/{n}: {Path(row['data_set']).name} "
+                                                        f"{row['status']}"))
     _write_summary(Path(root), rows, out_name)
     return rows
 

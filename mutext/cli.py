@@ -1,4 +1,4 @@
-"""Command-line interface: ``mutext diagnose``, ``mutext rig``, ``mutext demo`` and ``mutext grade``."""
+"""Command-line interface: ``mutext diagnose``, ``mutext rig``, ``mutext frf``, ``mutext demo`` and ``mutext grade``."""
 from __future__ import annotations
 
 import argparse
@@ -71,6 +71,7 @@ COMMANDS = {
     "diagnose": ("mutext.commands.diagnose",
                  "what a model gets wrong against measured FRFs, its cause, the extended model and the gain"),
     "rig": ("mutext.commands.rig", "virtual rig: 'rig hide' writes a data set with a hidden effect"),
+    "frf": ("mutext.commands.frf", "FRF files: 'frf convert' between mutext's CSV and Universal File data set 58"),
 }
 
 
@@ -91,12 +92,15 @@ def _cmd_grade(argv) -> int:
 def main(argv=None) -> int:
     argv = sys.argv[1:] if argv is None else list(argv)
     if not argv or argv[0] in ("-h", "--help"):
-        print("usage: mutext {diagnose,rig,demo,grade} ...\n\n"
+        print("usage: mutext {diagnose,rig,frf,demo,grade} ...\n\n"
               "  diagnose MODEL.toml DATA.csv [...] [--validate VAL.csv ...] [--out DIR] [--json]\n"
               "                                     what the model gets wrong, why, and the gain once fixed\n"
+              "  diagnose --batch DIR [--jobs N]    every data set under DIR, summary.csv and index.html\n"
               "  rig hide --seed N --out DIR        a data set with a hidden effect to diagnose\n"
+              "  frf convert IN OUT                 FRF file CSV <-> Universal File 58 (.csv, .uff, .unv)\n"
               "  demo NAME [options]                run a demonstration (mutext demo --list)\n"
-              "  grade EXERCISE SUBMISSION [--json] score a submission offline\n")
+              "  grade EXERCISE SUBMISSION [--json] score a submission offline\n"
+              "  grade EXERCISE DIR [--jobs N]      every submission in DIR: results per file, summary.csv\n")
         return 0
     cmd, rest = argv[0], argv[1:]
     try:
@@ -114,7 +118,7 @@ def main(argv=None) -> int:
         import os
         os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
         return 0
-    print(f"mutext: unknown command '{cmd}' (expected one of diagnose, rig, demo, grade)", file=sys.stderr)
+    print(f"mutext: unknown command '{cmd}' (expected one of diagnose, rig, frf, demo, grade)", file=sys.stderr)
     return 2
 
 

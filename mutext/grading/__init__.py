@@ -4,7 +4,9 @@
 student's file and prints per-question points with feedback; ``--json``
 writes the Gradescope ``results.json`` schema instead (``{"score": ...,
 "tests": [{"name", "score", "max_score", "output"}, ...]}``).  No network,
-no containers.
+no containers.  ``mutext grade EXERCISE DIR [--jobs N]`` grades every
+``*.py`` file in a directory, each as one, and writes a results file per
+submission and a class ``summary.csv`` (:mod:`mutext.grading.batch`).
 
 How a submission is run
 -----------------------
@@ -57,6 +59,8 @@ sandbox
     The child process, its isolation and its time limits.
 compare
     Frequency-response comparison with feedback per channel.
+batch
+    A directory of submissions: results per file, ``summary.csv``, parallel workers.
 ex01_two_mass_hinf
     Grader of the first exercise.
 ex04_beam_element

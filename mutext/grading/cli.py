@@ -1,4 +1,5 @@
-"""Command line of the autograder: ``mutext grade``."""
+"""Command line of the autograder: ``mutext grade EXERCISE FILE`` for one submission,
+``mutext grade EXERCISE DIR [--jobs N]`` for a directory of them (:mod:`.batch`)."""
 from __future__ import annotations
 
 import argparse
@@ -15,10 +16,13 @@ USAGE_ERROR = 2
 def _parser():
     p = argparse.ArgumentParser(
         prog="mutext grade",
-        description="Grade a submission offline: per-question points and feedback.",
-        epilog="Exit code 0 whenever grading completed (whatever the score), 2 on wrong usage.")
+        description="Grade a submission offline: per-question points and feedback. Given a directory, grade "
+                    "every .py file in it: a results file per submission and a class summary CSV.",
+        epilog="Exit code 0 whenever grading completed (whatever the score), 2 on wrong usage; for a directory, "
+               "1 if some submission could not be graded (named in the summary; the others are graded).")
     p.add_argument("exercise", nargs="?", help="exercise name (see --list); a unique prefix such as ex01 works")
-    p.add_argument("submission", nargs="?", help="the student's .py file")
+    p.add_argument("submission", nargs="?", help="the student's .py file, or a directory of submissions "
+                                                 "(every *.py file directly in it)")
     p.add_argument("--list", action="store_true", help="list the exercises and exit")
     p.add_argument("--json", action="store_true",
                    help="write the Gradescope results.json (to stdout, or to --output) instead of the report")
@@ -26,6 +30,12 @@ def _parser():
                                                     "unless --json is given)")
     p.add_argument("--time-limit", type=float, default=60.0, metavar="SECONDS",
                    help="wall-clock limit for importing the submission and for each question (default 60)")
+    b = p.add_argument_group("a directory of submissions")
+    b.add_argument("--jobs", type=int, default=None, metavar="N",
+                   help="submissions graded at once (default 1; -1: all cores); each still in its own confined "
+                        "process")
+    b.add_argument("--out", metavar="DIR", help="where <submission>.json and summary.csv go (default DIR/results)")
+    b.add_argument("--quiet", action="store_true", help="no progress on stderr")
     return p
 
 
@@ -49,6 +59,12 @@ def main(argv) -> int:
         print(f"mutext grade: error: --time-limit must be a positive number of seconds, got {args.time_limit:g}",
               file=sys.stderr)
         return USAGE_ERROR
+    if Path(args.submission).is_dir():
+        return _batch(args)
+    if args.jobs is not None or args.out is not None:
+        print("mutext grade: error: --jobs and --out are for a directory of submissions; for one file use "
+              "--output FILE", file=sys.stderr)
+        return USAGE_ERROR
     try:
         report = grade(args.exercise, args.submission, time_limit=args.time_limit)
     except GradingError as exc:
@@ -66,3 +82,54 @@ def main(argv) -> int:
     elif not args.json:
         print(report.text())
     return 0
+
+
+def _batch(args) -> int:
+    """``mutext grade EXERCISE DIR``: every submission in DIR, a results file each and summary.csv."""
+    import os
+
+    from ..progress import ProgressLine
+    from .batch import grade_batch
+    if args.output:
+        print("mutext grade: error: --output names one results.json; for a directory the results go to "
+              "--out DIR (default DIR/results)", file=sys.stderr)
+        return USAGE_ERROR
+    jobs = 1 if args.jobs is None else args.jobs
+    try:
+        res = grade_batch(args.exercise, args.submission, jobs=jobs, time_limit=args.time_limit, out_dir=args.out,
+                          progress=ProgressLine(enabled=not args.quiet))
+    except GradingError as exc:
+        print(f"mutext grade: error: {exc}", file=sys.stderr)
+        return USAGE_ERROR
+    for note in res.notes:
+        print(f"mutext grade: note: {note}", file=sys.stderr)
+    if args.json:
+        rows = [{k: v for k, v in r.items() if k != "isolation_details"} for r in res.rows]
+        print(json.dumps(rows, indent=2))
+        return 1 if res.failed else 0
+    width = max(12, *(len(r["submission"]) for r in res.rows))
+    qids = [qid for qid, _ in res.questions]
+    print(f"Exercise {res.exercise}: {len(res.rows)} submissions in {res.directory}")
+    print(f"{'submission':<{width}}  " + " ".join(f"{q:>5}" for q in qids) + "  total  notes")
+    print(f"{'(points)':<{width}}  " + " ".join(f"{p:>5g}" for _, p in res.questions)
+          + f"  {sum(p for _, p in res.questions):>5g}")
+    for r in res.rows:
+        if r["status"] == "graded":
+            cells = " ".join(f"{r.get(q, 0):>5.2f}" for q in qids) + f"  {r['score']:>5.2f}"
+            notes = "; ".join(t for t in (r.get("integrity"), r.get("problems")) if t)
+        else:
+            cells = " ".join(f"{'-':>5}" for _ in qids) + f"  {'-':>5}"
+            notes = f"NOT GRADED: {r.get('error', '')}"
+        print(f"{r['submission']:<{width}}  {cells}  {notes[:100]}")
+    graded = [r for r in res.rows if r["status"] == "graded"]
+    line = f"{len(graded)} of {len(res.rows)} graded"
+    if res.failed:
+        line += f", {len(res.failed)} could not be graded ({', '.join(r['submission'] for r in res.failed)})"
+    if graded:
+        mean = sum(r["score"] for r in graded) / len(graded)
+        line += f"; mean {mean:.2f} / {graded[0]['max_score']:g}"
+    isol = sorted({r.get("isolation", "none") for r in graded})
+    print(line + (f"; isolation: {', '.join(isol)}" if isol else "")
+          + (f"; {res.jobs} at a time" if res.jobs != 1 else "; one at a time"))
+    print(f"results: {os.path.join(str(res.out_dir), '<submission>.json')}; summary: {res.summary}")
+    return 1 if res.failed else 0
