@@ -146,6 +146,9 @@ EXERCISES = {
                           "convergence"),
     "ex05_diagnose": ("mutext.grading.ex05_diagnose",
                       "diagnosis: log misfit, a grounded spring added, its size fitted, a hidden effect found"),
+    "ex06_sidebands": ("mutext.grading.ex06_sidebands",
+                       "cracked rotor at speed: where sidebands appear, a local sideband detector, breathing "
+                       "crack, open crack or none"),
 }
 
 
