@@ -107,18 +107,33 @@ def _partition(P: ct.StateSpace, nmeas: int, ncon: int) -> PlantParts:
 
 
 def _uncontrollable_modes(A, B, tol=1e-9):
-    """Eigenvalues of A in the closed right half plane that (A, B) cannot move (PBH test)."""
+    """Eigenvalues of A in the closed right half plane that (A, B) cannot move (PBH test).
+
+    Scale-invariant: the columns of B are normalised and A - lam I is divided by
+    the norm of A, so multiplying A, B or single inputs by a constant does not
+    change the answer (an absolute tolerance declared a plant with B scaled by
+    1e-8 not stabilizable)."""
     n = A.shape[0]
-    scale = max(1.0, np.linalg.norm(np.hstack([A, B]), 2))
+    normA = float(np.linalg.norm(A, 2)) if A.size else 0.0
+    sa = normA if normA > 0 else 1.0
+    cb = np.linalg.norm(B, axis=0) if B.size else np.zeros(B.shape[1] if B.ndim == 2 else 0)
+    Bn = B[:, cb > 0] / cb[cb > 0] if B.size else B
     bad = []
     for lam in np.linalg.eigvals(A):
-        if lam.real < -1e-9 * max(1.0, abs(lam)):
+        if lam.real < -1e-9 * max(abs(lam), 1e-3 * sa):
             continue
-        M = np.hstack([A - lam * np.eye(n), B])
+        M = np.hstack([(A - lam * np.eye(n)) / sa, Bn])
         smin = np.linalg.svd(M, compute_uv=False)[-1] if M.size else 0.0
-        if smin < tol * scale:
+        if smin < tol:
             bad.append(lam)
     return bad
+
+
+def _labels(P, kind):
+    try:
+        return list(P.input_labels if kind == "in" else P.output_labels)
+    except AttributeError:  # pragma: no cover
+        return []
 
 
 def check_plant(P, nmeas: int, ncon: int) -> tuple[ct.StateSpace, PlantParts, list[str]]:
@@ -129,11 +144,11 @@ def check_plant(P, nmeas: int, ncon: int) -> tuple[ct.StateSpace, PlantParts, li
     :class:`ModelError` for malformed input (sizes, non-finite entries) and
     :class:`IllPosedError` when no stabilizing controller can exist.
     """
+    for name, v in (("nmeas", nmeas), ("ncon", ncon)):
+        if isinstance(v, (bool, np.bool_)) or not isinstance(v, (int, np.integer)) or v < 1:
+            raise ModelError(f"{name} must be a positive integer, got {v!r}")
     P = as_ss(P, "P")
     check_finite(P, "P")
-    for name, v in (("nmeas", nmeas), ("ncon", ncon)):
-        if not isinstance(v, (int, np.integer)) or v < 1:
-            raise ModelError(f"{name} must be a positive integer, got {v!r}")
     if ncon >= P.ninputs:
         raise ModelError(f"ncon={ncon} but P has only {P.ninputs} inputs: "
                          "at least one exogenous input w must remain")
@@ -142,6 +157,30 @@ def check_plant(P, nmeas: int, ncon: int) -> tuple[ct.StateSpace, PlantParts, li
                          "at least one performance output z must remain")
     parts = _partition(P, nmeas, ncon)
     notes = []
+    # a control input that moves neither the state nor z, or a measurement that
+    # sees neither the state nor w, means the port counts are wrong (a different
+    # problem would be solved silently)
+    ins, outs = _labels(P, "in"), _labels(P, "out")
+    Bu = np.vstack([parts.B2, parts.D12])
+    Cy = np.hstack([parts.C2, parts.D21])
+    ref_in = max(float(np.abs(np.vstack([np.hstack([parts.B1, parts.B2]),
+                                          np.hstack([parts.D11, parts.D12])])).max(initial=0.0)), 1e-300)
+    ref_out = max(float(np.abs(np.hstack([np.vstack([parts.C1, parts.C2]),
+                                          np.vstack([parts.D11, parts.D21])])).max(initial=0.0)), 1e-300)
+    for j in range(ncon):
+        if np.abs(Bu[:, j]).max(initial=0.0) <= 1e-14 * ref_in:
+            k = P.ninputs - ncon + j
+            lab = f" ('{ins[k]}')" if k < len(ins) else ""
+            raise ModelError(f"ncon={ncon}: control input {k + 1}{lab} of P moves neither the state nor a "
+                             f"performance output (its columns of B2 and D12 are zero); the last ncon inputs "
+                             f"of P are taken as controls -- is ncon right? (inputs: {', '.join(ins)})")
+    for i in range(nmeas):
+        if np.abs(Cy[i]).max(initial=0.0) <= 1e-14 * ref_out:
+            k = P.noutputs - nmeas + i
+            lab = f" ('{outs[k]}')" if k < len(outs) else ""
+            raise ModelError(f"nmeas={nmeas}: measurement {k + 1}{lab} of P sees neither the state nor an "
+                             f"exogenous input (its rows of C2 and D21 are zero); the last nmeas outputs of P "
+                             f"are taken as measurements -- is nmeas right? (outputs: {', '.join(outs)})")
     if parts.n:
         bad = _uncontrollable_modes(parts.A, parts.B2)
         if bad:
@@ -173,8 +212,16 @@ def check_plant(P, nmeas: int, ncon: int) -> tuple[ct.StateSpace, PlantParts, li
 # ----------------------------------------------------------------------------
 
 def _scale(parts: PlantParts):
-    """Balance states, normalise u and y channels.  Returns (scaled parts, su, sy)
-    with u = diag(su) u_s and y_s = diag(sy) y."""
+    """Balance states, rescale time, normalise the w -> z gain and the u and y channels.
+
+    Returns ``(scaled parts, su, sy, t, alpha, c0)`` with ``u = diag(su) u_s``,
+    ``y_s = diag(sy) y``, the frequency axis rescaled by ``alpha`` (see
+    :func:`_time_scale`) and w, z scaled so that the level of the scaled plant
+    is the level of the original divided by ``c0``.  Every factor is a power of
+    two and the steps are ordered so that multiplying the plant's matrices by
+    constants (units, time scale) gives the same scaled plant: the answer is
+    scale-invariant (multiplying every matrix by 1e8 used to move the level).
+    """
     p = parts
     n, nw, nu, nz, ny = p.sizes
     B = np.hstack([p.B1, p.B2])
@@ -182,14 +229,29 @@ def _scale(parts: PlantParts):
     D = np.block([[p.D11, p.D12], [p.D21, p.D22]])
     bal, t = balance_states(ss(p.A, B, C, D)) if n else (ss(p.A, B, C, D), np.ones(0))
     A, B, C = (np.asarray(X, float) for X in (bal.A, bal.B, bal.C))
-    B1, B2, C1, C2 = B[:, :nw], B[:, nw:], C[:nz], C[nz:]
-    cu = np.linalg.norm(np.vstack([B2, p.D12]), axis=0)
-    su = np.where(cu > 0, 1.0 / np.where(cu > 0, cu, 1.0), 1.0)
-    ry = np.linalg.norm(np.hstack([C2, p.D21]), axis=1)
-    sy = np.where(ry > 0, 1.0 / np.where(ry > 0, ry, 1.0), 1.0)
-    scaled = PlantParts(A, B1, B2 * su, C1, C2 * sy[:, None], p.D11, p.D12 * su,
-                        p.D21 * sy[:, None], (p.D22 * su) * sy[:, None])
-    return scaled, su, sy, t
+    work = PlantParts(A, B[:, :nw], B[:, nw:], C[:nz], C[nz:], p.D11, p.D12, p.D21, p.D22)
+    # frequencies of order one: the LMI entries A R + R A^T and the gamma blocks
+    # are then of comparable size
+    alpha = 1.0
+    mags = np.abs(np.linalg.eigvals(A)) if n else np.zeros(0)
+    if mags.size and mags.max() > 0:
+        alpha = float(2.0 ** np.round(np.log2(mags.max())))
+        work = _time_scale(work, alpha)
+    # w -> z gain of order one (a rough, coordinate-free estimate); done before
+    # the u, y normalisation so that the latter does not depend on the units of z, w
+    g_est = max(float(np.linalg.norm(work.D11, 2)) if work.D11.size else 0.0,
+                (float(np.linalg.norm(work.C1, 2)) * float(np.linalg.norm(work.B1, 2))) if n else 0.0)
+    c0 = float(2.0 ** np.round(np.log2(g_est))) if g_est > 0 and np.isfinite(g_est) else 1.0
+    if c0 != 1.0:
+        work = _transform(work, np.eye(n), c0)
+    cu = np.linalg.norm(np.vstack([work.B2, work.D12]), axis=0)
+    su = np.where(cu > 0, 2.0 ** -np.round(np.log2(np.where(cu > 0, cu, 1.0))), 1.0)
+    ry = np.linalg.norm(np.hstack([work.C2, work.D21]), axis=1)
+    sy = np.where(ry > 0, 2.0 ** -np.round(np.log2(np.where(ry > 0, ry, 1.0))), 1.0)
+    w = work
+    scaled = PlantParts(w.A, w.B1, w.B2 * su, w.C1, w.C2 * sy[:, None], w.D11, w.D12 * su,
+                        w.D21 * sy[:, None], (w.D22 * su) * sy[:, None])
+    return scaled, su, sy, t, alpha, c0
 
 
 # ----------------------------------------------------------------------------
@@ -686,21 +748,16 @@ def _time_scale(p: PlantParts, alpha: float) -> PlantParts:
 
 def _level(parts: PlantParts, notes: list, solver: str, scale: bool, refine: bool) -> _Level:
     nmeas, ncon = parts.C2.shape[0], parts.B2.shape[1]
-    work, su, sy, tstate = _scale(parts) if scale else (parts, np.ones(ncon), np.ones(nmeas), np.ones(parts.n))
-    alpha = 1.0
     if scale:
-        # frequencies of order one: the LMI entries A R + R A^T and the gamma
-        # blocks are then of comparable size
-        mags = np.abs(np.linalg.eigvals(work.A))
-        if mags.max() > 0:
-            alpha = float(2.0 ** np.round(np.log2(mags.max())))
-            work = _time_scale(work, alpha)
+        work, su, sy, tstate, alpha, c0 = _scale(parts)
+    else:
+        work, su, sy, tstate, alpha, c0 = parts, np.ones(ncon), np.ones(nmeas), np.ones(parts.n), 1.0, 1.0
     D22 = work.D22
     work0 = PlantParts(work.A, work.B1, work.B2, work.C1, work.C2, work.D11, work.D12, work.D21,
                        np.zeros_like(D22))
     # Pass 0 locates the level.  If the solver gives up, retry with w and z
     # scaled down (large levels make the gamma blocks dominate the LMIs).
-    gscale, first, errors = 1.0, None, []
+    gscale, first, errors = c0, None, []
     for c in (1.0, 1e3, 1e6):
         trial = _transform(work0, np.eye(parts.n), c) if c != 1.0 else work0
         for tight in (False, True):
@@ -712,13 +769,26 @@ def _level(parts: PlantParts, notes: list, solver: str, scale: bool, refine: boo
             except InfeasibleError as exc:
                 errors.append(str(exc))
                 break
+            except (ValueError, np.linalg.LinAlgError) as exc:   # NaN in the problem data
+                errors.append(f"H-infinity optimal level: {exc}")
+                break
         if first is not None:
-            work0, gscale = trial, c
+            work0, gscale = trial, c0 * c
             break
     if first is None:
         raise SolverError(f"H-infinity optimal level: the LMI solver failed on the scaled plant{_near_axis_hint(parts)} "
                           f"(tried w, z scalings 1, 1e3, 1e6); last error: {errors[-1]}")
     g0, R, S, st1 = first
+    if not np.isfinite(g0) or g0 < 1e-8:
+        # the level of the normalised plant (w -> z gain of order one) is zero to
+        # the solver's accuracy: a singular problem whose infimum 0 is approached
+        # only by controllers of unbounded gain (e.g. an integrator with full
+        # control and measurement, z = x); there is no controller to return
+        raise IllPosedError(
+            f"H-infinity optimal level: the infimum of the closed-loop norm is 0 to solver accuracy "
+            f"(level {g0 * gscale:.3g} against a w -> z gain of about {gscale:.3g}); it is approached only by "
+            "controllers of unbounded gain and not attained (a singular problem: D12 or D21 rank deficient "
+            "without a penalty on u or noise on y). Add a control penalty in z or sensor noise in y.")
     # Later passes re-solve in the state coordinates that balance the previous
     # solution (R, S) and with w, z scaled so that the level is near 1.
     # Plant-based balancing alone leaves R and S spread over decades, which
@@ -732,9 +802,12 @@ def _level(parts: PlantParts, notes: list, solver: str, scale: bool, refine: boo
             T = np.eye(parts.n)
         c = gamma / gscale
         trial = _transform(work0, T, c)
+        if not all(np.all(np.isfinite(X)) for X in (trial.A, trial.B1, trial.B2, trial.C1, trial.C2, trial.D11,
+                                                      trial.D12, trial.D21)):
+            break
         try:
             g2, R2, S2, st2 = _optimal_level(trial, solver, tight=True)
-        except (InfeasibleError, SolverError):
+        except (InfeasibleError, SolverError, ValueError, np.linalg.LinAlgError):
             break
         g2 *= gscale * c
         levels.append(g2)
@@ -772,6 +845,65 @@ def _level(parts: PlantParts, notes: list, solver: str, scale: bool, refine: boo
 # ----------------------------------------------------------------------------
 
 _BACKOFFS = (1e-4, 3e-4, 1e-3, 3e-3, 1e-2, 3e-2, 0.1, 0.3)
+
+
+def _check_options(solver, backoff, max_backoff, controller_objective, bound_factor):
+    """Named errors for bad keyword arguments of :func:`hinfsyn` (before any solver runs)."""
+    if not isinstance(solver, str) or not solver:
+        raise ModelError(f"solver must be a cvxpy solver name (a string), got {solver!r}")
+    if solver.upper() not in cp.installed_solvers():
+        raise ModelError(f"solver {solver!r} is not installed; installed: {', '.join(cp.installed_solvers())}")
+    for name, v in (("backoff", backoff), ("max_backoff", max_backoff), ("bound_factor", bound_factor)):
+        if isinstance(v, (bool, np.bool_)) or not isinstance(v, (int, float, np.integer, np.floating)) \
+                or not np.isfinite(v) or v <= 0:
+            raise ModelError(f"{name} must be a positive finite number, got {v!r}")
+    if backoff > 1.0 or max_backoff > 1.0:
+        raise ModelError(f"backoff and max_backoff are relative distances above the optimal level and must "
+                         f"be at most 1 (100 %), got backoff={backoff!r}, max_backoff={max_backoff!r}")
+    if controller_objective not in ("coupling", "margin"):
+        raise ModelError(f"controller_objective must be 'coupling' or 'margin', got {controller_objective!r}")
+
+
+def _zero_level(P, parts, nmeas, ncon, notes, solver, scale, t0):
+    """The exogenous input w reaches no state and no z (B1 = 0, D11 = 0), or z
+    sees no state (C1 = 0, D11 = 0): every stabilizing controller gives the
+    closed-loop norm 0, the optimal level.  The LMIs degenerate at level 0, so
+    an observer-based stabilizing controller (two Riccati equations) is built
+    instead and checked like the LMI controllers."""
+    if scale:
+        work, su, sy, _, alpha, _ = _scale(parts)
+    else:
+        work, su, sy, alpha = parts, np.ones(ncon), np.ones(nmeas), 1.0
+    A, B2, C2 = work.A, work.B2, work.C2
+    n = A.shape[0]
+    try:
+        X = sla.solve_continuous_are(A, B2, np.eye(n), np.eye(ncon))
+        Y = sla.solve_continuous_are(A.T, C2.T, np.eye(n), np.eye(nmeas))
+    except (np.linalg.LinAlgError, ValueError) as exc:
+        raise SolverError(f"H-infinity synthesis at the optimal level 0 (w reaches no z): the Riccati "
+                          f"equations of the stabilizing observer-based controller failed ({exc})") from None
+    F = B2.T @ X
+    L = Y @ C2.T
+    Ak, Bk, Ck, Dk = A - B2 @ F - L @ C2, L, -F, np.zeros((ncon, nmeas))
+    Ak, Bk, Ck, Dk = _add_d22(Ak, Bk, Ck, Dk, work.D22)
+    ra = np.sqrt(alpha)
+    Ak, Bk, Ck = alpha * Ak, ra * Bk, ra * Ck
+    K = ss(Ak, Bk * sy[None, :], su[:, None] * Ck, su[:, None] * Dk * sy[None, :],
+           inputs=P.output_labels[-nmeas:], outputs=P.input_labels[-ncon:], name="K")
+    CL, stable, maxre, value, wpk, sly, gpk = _verify(P, K, nmeas, ncon)
+    if not stable:
+        raise SolverError("H-infinity synthesis at the optimal level 0 (w reaches no z): the observer-based "
+                          f"controller does not stabilize the closed loop (max real part {maxre:.3g})")
+    notes = list(notes) + ["the exogenous input w reaches no performance output z for any controller "
+                           "(B1 = 0 or C1 = 0, and D11 = 0): the optimal level is 0 and any stabilizing "
+                           "controller attains it; an observer-based (LQG-type) controller is returned"]
+    poles = np.linalg.eigvals(np.asarray(K.A, float)) if K.nstates else np.zeros(0)
+    return HinfResult(K=K, CL=CL, gamma=0.0, gamma_target=0.0, closed_loop_norm=value,
+                      closed_loop_norm_slycot=sly, closed_loop_norm_grid=gpk, peak_frequency=wpk,
+                      stable=stable, max_closed_loop_real_part=maxre, controller_poles=poles,
+                      backoff=0.0, notes=notes, solver=solver, seconds=time.perf_counter() - t0,
+                      info={"tries": [], "level_method": "exact (w does not reach z)", "u_scaling": su,
+                            "y_scaling": sy})
 
 
 def hinfsyn(P, nmeas: int, ncon: int, *, solver: str = "CLARABEL", backoff: float = 1e-4,
@@ -834,9 +966,12 @@ def hinfsyn(P, nmeas: int, ncon: int, *, solver: str = "CLARABEL", backoff: floa
     1.0069
     """
     t0 = time.perf_counter()
+    _check_options(solver, backoff, max_backoff, controller_objective, bound_factor)
     P, parts, notes = check_plant(P, nmeas, ncon)
     if parts.n == 0:
         raise ModelError("P has no states: static H-infinity synthesis is not supported")
+    if (not np.any(parts.D11)) and (not np.any(parts.B1) or not np.any(parts.C1)):
+        return _zero_level(P, parts, nmeas, ncon, notes, solver, scale, t0)
     lev = _level(parts, notes, solver, scale, refine)
     work0, D22, gscale, gamma, R, S = lev.work, lev.D22, lev.gscale, lev.gamma, lev.R, lev.S
     su, sy = lev.su, lev.sy
@@ -890,6 +1025,12 @@ def hinfsyn(P, nmeas: int, ncon: int, *, solver: str = "CLARABEL", backoff: floa
                           f"{schedule[0]:g}..{schedule[-1]:g}){_near_axis_hint(P)}; last outcome per objective: "
                           + "; ".join(f"{k}: {v}" for k, v in last.items()))
     K, CL, stable, maxre, value, wpk, sly, gpk, gK, b = best
+    if gamma < lev.gamma_lmi * (1 - 1e-6) and value > lev.gamma_lmi * (1 + 1e-3):
+        # check of the reported level against the achieved one: the Riccati
+        # refinement lowered the level, but no controller comes near even the LMI's
+        notes.append(f"the reported level {gamma:.6g} (Riccati refinement of the LMI level "
+                     f"{lev.gamma_lmi:.6g}) is not confirmed by a controller: the best one achieves "
+                     f"{value:.6g}; treat the level as uncertain between the two")
     if value > gK * (1 + 1e-6):
         notes.append(f"the best controller found achieves {value:.6g}, above the target level {gK:.6g}")
     elif b > 1e-3:

@@ -51,6 +51,8 @@ def blas_single_thread():
 
 def ss(A, B, C, D, *, inputs=None, outputs=None, states=None, name=None) -> ct.StateSpace:
     """Continuous-time state space with 2-D float matrices (empty blocks allowed)."""
+    _check_real(A, B, C, D, what=name or "system")
+    A, B, C, D = (np.real(X) if np.iscomplexobj(X) else X for X in (A, B, C, D))
     A = np.atleast_2d(np.asarray(A, dtype=float))
     n = A.shape[0] if A.size else 0
     B = np.asarray(B, dtype=float).reshape(n, -1) if n else np.zeros((0, np.asarray(D).shape[1] if np.ndim(D) == 2 else 0))
@@ -73,12 +75,19 @@ def as_ss(sys, what: str = "system") -> ct.StateSpace:
     """Coerce a StateSpace, TransferFunction, (A, B, C, D) tuple or a constant
     matrix to a continuous-time :class:`control.StateSpace`."""
     if isinstance(sys, ct.StateSpace):
+        _check_real(sys.A, sys.B, sys.C, sys.D, what=what)
         out = sys
     elif isinstance(sys, ct.TransferFunction):
         out = ct.ss(sys)
     elif isinstance(sys, (tuple, list)) and len(sys) == 4:
-        out = ss(*sys)
+        _check_real(*sys, what=what)
+        try:
+            out = ss(*sys)
+        except (TypeError, ValueError) as exc:
+            raise ModelError(f"{what}: the (A, B, C, D) matrices are malformed or of inconsistent sizes "
+                             f"({exc})") from None
     else:
+        _check_real(sys, names="D", what=what)
         try:
             Dm = np.atleast_2d(np.asarray(sys, dtype=float))
         except (TypeError, ValueError):
@@ -88,6 +97,19 @@ def as_ss(sys, what: str = "system") -> ct.StateSpace:
     if not ct.isctime(out, strict=False) or (out.dt not in (0, None)):
         raise ModelError(f"{what} must be continuous-time (dt=0); got dt={out.dt}")
     return out
+
+
+def _check_real(*mats, names="ABCD", what="system"):
+    """Raise :class:`ModelError` if a matrix has a nonzero imaginary part (it would
+    be dropped with only a ComplexWarning when converted to float)."""
+    for name, X in zip(names, mats):
+        try:
+            arr = np.asarray(X)
+        except Exception:  # noqa: BLE001 - left to the conversion that follows
+            continue
+        if np.iscomplexobj(arr) and arr.size and np.any(np.imag(arr) != 0):
+            raise ModelError(f"{what}.{name} is complex (nonzero imaginary parts): only real systems are "
+                             f"supported (a complex matrix would lose its imaginary part)")
 
 
 def check_finite(sys: ct.StateSpace, what: str = "system") -> None:

@@ -52,7 +52,7 @@ from dataclasses import dataclass, field
 import control as ct
 import numpy as np
 
-from .errors import IllPosedError, ModelError
+from .errors import IllPosedError, InfeasibleError, ModelError, SolverError
 from .lti import as_ss, check_finite, freqresp, is_stable, lft_lower, ss
 from .mu import Block, BlockStructure
 
@@ -349,25 +349,53 @@ def fit_impedance(K, omega, weight=None, tol: float = 0.1) -> ImpedanceFit:
         else np.asarray(K, complex).ravel()
     if Kj.shape != omega.shape:
         raise ModelError(f"K has {Kj.size} response values for {omega.size} frequencies")
-    wgt = np.ones_like(omega) if weight is None else np.asarray(weight, float).ravel()
+    if not np.all(np.isfinite(omega)) or np.any(omega <= 0) or omega.max() > 1e100:
+        raise ModelError("fit_impedance: omega must hold positive, finite frequencies (rad/s, at most 1e100)")
+    if not np.all(np.isfinite(Kj)):
+        raise ModelError("fit_impedance: K has non-finite response values on omega")
+    if weight is None:
+        wgt = np.ones_like(omega)
+    else:
+        try:
+            wgt = np.asarray(weight, float).ravel()
+        except (TypeError, ValueError):
+            raise ModelError(f"fit_impedance: weight must be an array of real numbers, got {weight!r}") from None
+        if wgt.size == 1:
+            wgt = np.full(omega.size, float(wgt[0]))
+        if wgt.shape != omega.shape:
+            raise ModelError(f"fit_impedance: weight has {wgt.size} values for {omega.size} frequencies")
+        if not np.all(np.isfinite(wgt)):
+            i = int(np.flatnonzero(~np.isfinite(wgt))[0])
+            raise ModelError(f"fit_impedance: weight[{i}] is {wgt[i]} (weights must be finite)")
+        if np.any(wgt < 0):
+            i = int(np.flatnonzero(wgt < 0)[0])
+            raise ModelError(f"fit_impedance: weight[{i}] = {wgt[i]:g} is negative (weights must be >= 0)")
+        if np.count_nonzero(wgt) < 2:
+            raise ModelError(f"fit_impedance: only {np.count_nonzero(wgt)} of the {wgt.size} weights are "
+                             "positive; at least 2 frequencies must count to determine mass, damper and spring")
+    if not (isinstance(tol, (int, float, np.integer, np.floating)) and np.isfinite(tol) and tol >= 0):
+        raise ModelError(f"fit_impedance: tol must be a non-negative finite number, got {tol!r}")
     # real part: dk - w^2 dm; imaginary part: w dc; scale the columns for conditioning
     A = np.zeros((2 * omega.size, 3))
     A[:omega.size, 0] = -omega ** 2
     A[:omega.size, 2] = 1.0
     A[omega.size:, 1] = omega
     b = np.concatenate([Kj.real, Kj.imag])
-    W = np.concatenate([wgt, wgt])
+    # only relative weights shape the fit: normalise them (a weight of 1e152 overflowed)
+    wscale = float(wgt.max())
+    wn = wgt / wscale
+    W = np.concatenate([wn, wn])
     col = np.linalg.norm(A * W[:, None], axis=0)
     col[col == 0] = 1.0
     Aw = A * W[:, None] / col
     x, *_ = np.linalg.lstsq(Aw, b * W, rcond=None)
     dm, dc, dk = x / col
     fit = dk + 1j * omega * dc - omega ** 2 * dm
-    res = float(np.linalg.norm(wgt * (Kj - fit)) / max(np.linalg.norm(wgt * Kj), 1e-300))
+    res = float(np.linalg.norm(wn * (Kj - fit)) / max(np.linalg.norm(wn * Kj), 1e-300))
     # standard uncertainty: the weights are read as inverse standard deviations of K
     # (for the identification weights 1/|s|: the change of K that moves the
     # normalised error by one); without weights, from the residual variance
-    cov = np.linalg.pinv(Aw.T @ Aw) / np.outer(col, col)
+    cov = np.linalg.pinv(Aw.T @ Aw) / np.outer(col, col) / wscale ** 2
     if weight is None:
         dof = max(2 * omega.size - 3, 1)
         cov *= float(np.sum(np.abs(Kj - fit) ** 2)) / dof
@@ -566,7 +594,7 @@ def _default_omega(plant: MBIPlant, n: int = 300):
 
 
 def true_from_frf(frf, engineering, *, excitation: str, measurement: str, tol: float = 0.02,
-                  max_order: int = 24):
+                  max_order: int = 24, max_residual: float = 0.2):
     r"""A state-space stand-in for a measured FRF, to serve as the true system.
 
     The measured response (:class:`mutext.rig.FRF`, SI units, the excitation
@@ -579,7 +607,10 @@ def true_from_frf(frf, engineering, *, excitation: str, measurement: str, tol: f
     ModelError
         No frequency overlap: none of the engineering model's modes lies in the
         measured band (the identification would compare the two where neither
-        says anything about the other), or unusable data.
+        says anything about the other), unusable data, or data that no stable
+        rational model up to ``max_order`` fits to an RMS relative residual of
+        ``max_residual`` (noise, or not a frequency response): identifying
+        against such a stand-in would only fit the fit's errors.
 
     Returns
     -------
@@ -595,7 +626,16 @@ def true_from_frf(frf, engineering, *, excitation: str, measurement: str, tol: f
     if modes.size and not np.any((modes >= f.min()) & (modes <= f.max())):
         raise ModelError(f"measured FRF{_source(frf)}: no frequency overlap: it covers {f.min():.4g}-{f.max():.4g} Hz, "
                          f"the engineering model's modes lie at {', '.join(f'{m:.4g}' for m in modes[:6])} Hz")
+    if not (isinstance(max_residual, (int, float, np.integer, np.floating)) and max_residual > 0):
+        raise ModelError(f"max_residual must be a positive number, got {max_residual!r}")
     fit = fit_frf_auto(2 * np.pi * f, frf.response, tol=tol, max_order=max_order)
+    over = [n for n in fit.notes if n.startswith("over-fitted")]
+    if not fit.residual <= max_residual or over:
+        why = over[0] if over else (f"the best stable rational fit (order {fit.order}) leaves an RMS relative "
+                                    f"residual of {fit.residual:.3g} > max_residual={max_residual:g}")
+        raise ModelError(f"measured FRF{_source(frf)}: cannot serve as the true system: {why}; the data look "
+                         "like noise or not like the response of a linear system (check the channel, the "
+                         "units and the coherence), or raise max_order / max_residual knowingly")
     sys = ss(fit.system.A, fit.system.B, fit.system.C, fit.system.D, inputs=[excitation], outputs=[measurement])
     return sys, fit
 
@@ -608,7 +648,8 @@ def _source(frf) -> str:
 def identify(true, engineering, *, excitation: str, measurement: str, control_input: str,
              control_output: str, Ww: float = 1.0, Wz: float | None = None, tol: float = 0.05,
              max_tries: int = 8, regularization: float | None = 1e-4, omega=None,
-             dk_options: dict | None = None, out=None) -> MBIResult:
+             dk_options: dict | None = None, out=None, time_limit: float | None = None,
+             max_fit_residual: float = 0.2) -> MBIResult:
     r"""Identify the unmodeled dynamics of ``engineering`` by mu-synthesis (thesis sec. 3.5).
 
     Runs D-K iteration on the plant of :func:`mbi_plant` and tunes :math:`W_z`
@@ -642,6 +683,20 @@ def identify(true, engineering, *, excitation: str, measurement: str, control_in
         Passed to :func:`mutext.dk.dk_iteration`.
     out : file or None
         Progress (one line per try, and the D-K tables); default None: silent (the demos pass a stream).
+    time_limit : float, optional
+        Budget in seconds: no new D-K run is started once it is spent (a run
+        under way is finished).  The notes of the result report the budget and
+        what was used.
+    max_fit_residual : float
+        For a measured FRF: largest RMS relative residual of its rational fit
+        (:func:`true_from_frf`) for which identification goes on.
+
+    Raises
+    ------
+    ModelError
+        ``max_tries`` not a positive integer, ``time_limit`` not positive,
+        a measured FRF that cannot be fitted (see :func:`true_from_frf`), no
+        frequency overlap, a bad grid.
 
     Returns
     -------
@@ -652,10 +707,20 @@ def identify(true, engineering, *, excitation: str, measurement: str, control_in
     from .dk import dk_iteration
     from .rig import FRF
     t0 = time.perf_counter()
+    if isinstance(max_tries, (bool, np.bool_)) or not isinstance(max_tries, (int, np.integer)) or max_tries < 1:
+        raise ModelError(f"identify: max_tries must be a positive integer (the number of D-K runs allowed), "
+                         f"got {max_tries!r}")
+    if time_limit is not None and (isinstance(time_limit, (bool, np.bool_))
+                                   or not isinstance(time_limit, (int, float, np.integer, np.floating))
+                                   or not time_limit > 0):
+        raise ModelError(f"identify: time_limit must be a positive number of seconds or None, got {time_limit!r}")
+    if not (isinstance(tol, (int, float, np.integer, np.floating)) and 0 < tol < 1):
+        raise ModelError(f"identify: tol must lie in (0, 1), got {tol!r}")
     measured_fit = None
     if isinstance(true, FRF):
         measured = true
-        true, measured_fit = true_from_frf(measured, engineering, excitation=excitation, measurement=measurement)
+        true, measured_fit = true_from_frf(measured, engineering, excitation=excitation, measurement=measurement,
+                                           max_residual=max_fit_residual)
         band = 2 * np.pi * np.asarray(measured.freq_hz, float)
         if omega is None:
             omega = band
@@ -705,16 +770,30 @@ def identify(true, engineering, *, excitation: str, measurement: str, control_in
               f"{floor.omega:.4g} rad/s)", file=out, flush=True)
     opts = {"max_iter": 4, "out": None if out is None else out}
     opts.update(dk_options or {})
-    tries, runs = [], []
+    tries, runs, failed = [], [], []
     lo = floor.value or None    # Wz with mu > 1 (too tight; the floor is one) / mu <= 1
     hi = None
     target = 1.0 - tol / 2
+    stopped_by_time = False
     for k in range(max_tries):
+        if time_limit is not None and k > 0 and time.perf_counter() - t0 > time_limit:
+            stopped_by_time = True
+            break
         plant = mbi_plant(true, engineering, Wz=Wz, **kw)
         if out is not None:
             print(f"[mbi] try {k + 1}: Wz = {Wz:.4g}", file=out, flush=True)
         ti = time.perf_counter()
-        res = dk_iteration(plant.P, plant.structure, 1, 1, omega=omega, **opts)
+        try:
+            res = dk_iteration(plant.P, plant.structure, 1, 1, omega=omega, **opts)
+        except (SolverError, InfeasibleError) as exc:
+            # the controller construction is numerically erratic on some badly scaled plants: a
+            # slightly looser W_z is a differently scaled plant, and the search goes on
+            failed.append((Wz, str(exc)))
+            if out is not None:
+                print(f"[mbi]        the K step failed at this W_z ({str(exc)[:90]}...); trying 7 % looser",
+                      file=out, flush=True)
+            Wz = float(Wz * 1.07)
+            continue
         mu = float(max(res.mu_upper_dg, 0.0)) if np.isfinite(res.mu_upper_dg) else float(res.mu_upper)
         tries.append(WzTry(Wz, mu, float(res.mu_lower), res.controller_order, time.perf_counter() - ti,
                            len(res.history)))
@@ -741,10 +820,16 @@ def identify(true, engineering, *, excitation: str, measurement: str, control_in
         elif lo is not None and new <= lo:
             new = lo * 1.1
         Wz = float(new)
+    if not runs:
+        raise SolverError(f"identify: every D-K run failed ({len(failed)} W_z values from {failed[0][0]:.4g} to "
+                          f"{failed[-1][0]:.4g}); the last: {failed[-1][1]}")
     ok = [i for i, t in enumerate(tries) if t.mu_upper <= 1.0]
     best = min(ok, key=lambda i: tries[i].Wz) if ok else int(np.argmin([t.mu_upper for t in tries]))
     plant, res = runs[best]
     notes = start_notes
+    if failed:
+        notes.append(f"the K step failed at {len(failed)} W_z value(s) ("
+                     + ", ".join(f"{w:.4g}" for w, _ in failed) + "); the search moved on to looser ones")
     if measured_fit is not None:
         Gm = np.asarray(measured.response, complex)
         xc = freqresp(controlled_engineering(plant, res.K), 2 * np.pi * np.asarray(measured.freq_hz, float))[0, 0]
@@ -755,8 +840,13 @@ def identify(true, engineering, *, excitation: str, measurement: str, control_in
                      f"(relative residual {measured_fit.residual:.3g})" +
                      (f"; {measured_fit.notes[0]}" if measured_fit.notes else ""))
     if not 1.0 - tol <= tries[best].mu_upper <= 1.0:
-        notes.append(f"W_z search stopped after {len(tries)} tries without mu in [{1 - tol:.3g}, 1]; "
+        why = (f"the time limit of {time_limit:g} s was spent" if stopped_by_time
+               else f"max_tries={max_tries} was reached")
+        notes.append(f"W_z search stopped after {len(tries)} tries ({why}) without mu in [{1 - tol:.3g}, 1]; "
                      f"returning the try with {'the smallest W_z at mu <= 1' if ok else 'the lowest mu (> 1)'}")
+    limit = "none" if time_limit is None else f"{time_limit:g} s"
+    notes.append(f"budget: max_tries {max_tries}, time_limit {limit}; used {len(tries)} D-K run(s) in "
+                 f"{time.perf_counter() - t0:.1f} s")
     if plant.eps_u or plant.eps_y:
         notes.append(f"regularised: control penalty {plant.eps_u:.3g} per unit u, sensor noise "
                      f"{plant.eps_y:.3g} (the thesis plant is singular)")

@@ -106,7 +106,7 @@ from typing import Sequence
 
 import numpy as np
 
-from .errors import ModelError, SolverError
+from .errors import IllPosedError, ModelError, SolverError
 
 __all__ = ["Block", "BlockStructure", "MuUpper", "MuLower", "MuBounds", "MuSweep",
            "mu_upper", "mu_lower", "mu_bounds", "mu_sweep", "default_grid", "scaled_sigma",
@@ -327,12 +327,48 @@ class BlockStructure:
         return dl, dr
 
 
+def _as_structure(structure, what: str = "structure") -> "BlockStructure":
+    """``structure`` as a :class:`BlockStructure` (a list of :class:`Block` or a
+    MATLAB-like ``blk`` spec is converted), or a :class:`ModelError` naming it."""
+    if isinstance(structure, BlockStructure):
+        return structure
+    if structure is None or isinstance(structure, (str, bytes, int, float, complex, np.ndarray)) \
+            and not (isinstance(structure, np.ndarray) and structure.ndim == 2):
+        raise ModelError(f"{what} must be a BlockStructure (e.g. BlockStructure([Block.scalar(), "
+                         f"Block.full(2)])), got {structure!r}")
+    try:
+        items = list(structure)
+    except TypeError:
+        raise ModelError(f"{what} must be a BlockStructure, got {type(structure).__name__}") from None
+    if items and all(isinstance(b, Block) for b in items):
+        return BlockStructure(items)
+    try:
+        return BlockStructure.from_spec(items)
+    except (TypeError, ValueError) as exc:
+        if isinstance(exc, ModelError):
+            raise
+        raise ModelError(f"{what}: {structure!r} is neither a BlockStructure nor a list of Blocks nor a "
+                         f"blk spec like [[1, 1], [-1, 0]] ({exc})") from None
+
+
+def _norm2(M) -> float:
+    """Largest singular value, computed on a scaled copy so that entries near the
+    overflow or underflow limits do not break the SVD (inf if it overflows)."""
+    M = np.asarray(M)
+    amax = float(np.abs(M).max(initial=0.0))
+    if amax == 0 or not np.isfinite(amax):
+        return amax
+    with np.errstate(over="ignore"):
+        return float(np.linalg.norm(M / amax, 2) * amax)
+
+
 def scaled_sigma(M, structure: BlockStructure, d) -> float:
     r""":math:`\bar\sigma(D_\ell M D_r^{-1})` for one positive scaling per block (a valid upper bound).
 
     ``d`` holds one positive number per block; :math:`D_\ell` and :math:`D_r` repeat
     it over the block's columns and rows (:meth:`BlockStructure.expand_d`).
     """
+    structure = _as_structure(structure)
     d = np.asarray(d, dtype=float)
     if d.shape != (len(structure),) or not np.all(d > 0) or not np.all(np.isfinite(d)):
         raise ModelError(f"d must hold {len(structure)} positive finite numbers (one per block), got {d!r}")
@@ -517,13 +553,25 @@ def _osborne(M, S: BlockStructure, iterations: int = 30) -> np.ndarray:
 
 def _sigma_and_grad(M, S, x):
     r""":math:`\bar\sigma(e^X M e^{-X})` and the gradient of its logarithm, :math:`|u_k|^2 - |v_k|^2`."""
-    e = np.exp(x)
-    A = (e[S.col_block][:, None] / e[S.row_block][None, :]) * M
+    # in the log domain, scaled by the largest entry: exp(x) overflowing (and 0 * inf)
+    # made the SVD fail for badly scaled M
+    absM = np.abs(M)
+    nz = absM > 0
+    if not nz.any():
+        m = len(x)
+        return 0.0, np.zeros(m)
+    with np.errstate(divide="ignore"):
+        logA = np.where(nz, x[S.col_block][:, None] - x[S.row_block][None, :] + np.log(np.where(nz, absM, 1.0)),
+                        -np.inf)
+    L = float(logA.max())
+    A = np.where(nz, np.exp(logA - L) * (M / np.where(nz, absM, 1.0)), 0.0)
     U, s, Vh = np.linalg.svd(A)
+    with np.errstate(over="ignore", invalid="ignore"):
+        s0 = 0.0 if s[0] == 0 else float(s[0] * np.exp(L))
     m = len(x)
     g = (np.bincount(S.col_block, np.abs(U[:, 0]) ** 2, minlength=m)
          - np.bincount(S.row_block, np.abs(Vh[0]) ** 2, minlength=m))
-    return float(s[0]), g
+    return s0, g
 
 
 def _ellipsoid(M, S: BlockStructure, x0, tol: float, max_iter: int, radius: float):
@@ -907,7 +955,16 @@ def mu_upper(M, structure: BlockStructure, *, method: str = "lmi", real: str = "
     >>> round(mu_upper(M, S).value, 4), round(float(np.linalg.norm(M, 2)), 4)
     (3.0, 3.1623)
     """
+    structure = _as_structure(structure)
     M = structure.check(M)
+    if lower is not None:
+        if isinstance(lower, (bool, np.bool_)) or not isinstance(lower, (int, float, np.integer, np.floating)) \
+                or not np.isfinite(lower) or lower < 0:
+            raise ModelError(f"lower must be a non-negative finite lower bound on mu (or None), got {lower!r}")
+        cap = _norm2(M)
+        if lower > cap * (1 + 1e-9):
+            raise ModelError(f"lower={lower!r} cannot be a lower bound on mu: it exceeds sigma_max(M) = "
+                             f"{cap:.6g}, an upper bound")
     if method not in ("lmi", "osborne"):
         raise ModelError(f"method must be 'lmi' or 'osborne', got {method!r}")
     if real not in ("dg", "complex"):
@@ -915,7 +972,15 @@ def mu_upper(M, structure: BlockStructure, *, method: str = "lmi", real: str = "
     if not (np.isfinite(rtol) and 0 < rtol < 1):
         raise ModelError(f"rtol must lie in (0, 1), got {rtol}")
     S = structure
-    nrm = np.linalg.norm(M, 2)
+    nrm = _norm2(M)
+    if nrm != 0 and not 1e-100 <= nrm <= 1e100:
+        # mu is homogeneous: bound mu(M / nrm) and scale back (entries near 1e+-150
+        # overflow or underflow in the Gram matrices of the bound)
+        low = None if lower is None else float(lower) / nrm
+        up = mu_upper(M / nrm, S, method=method, real=real, rtol=rtol, lower=low)
+        return MuUpper(float(up.value * nrm), up.method, d=up.d, Dl=up.Dl, Dr=up.Dr,
+                       G=None if up.G is None else up.G * nrm, iterations=up.iterations,
+                       lower_level=float(up.lower_level * nrm) if up.lower_level is not None else None)
     if nrm == 0 or (len(S) == 1 and S.blocks[0].kind == "full"):
         return _diag_result(M, S, np.ones(len(S)), "sigma")
     if method == "osborne":
@@ -1358,7 +1423,25 @@ def mu_lower(M, structure: BlockStructure, *, rng=0, scalings=None) -> MuLower:
         at rounding level) and :math:`\bar\sigma(\Delta) = 1/\text{value}`;
         ``value`` is recomputed from ``Delta``.
     """
+    structure = _as_structure(structure)
     M = structure.check(M)
+    # mu is homogeneous, mu(cM) = |c| mu(M): work on M / ||M|| so that badly
+    # scaled matrices (entries near 1e+-150) do not overflow or underflow
+    nrm = _norm2(M)
+    if nrm == 0:
+        return MuLower(0.0, None, "sigma" if len(structure) == 1 and structure.blocks[0].kind == "full"
+                       else "power", np.nan)
+    if not np.isfinite(nrm):
+        raise ModelError("M is too large: its largest singular value overflows")
+    if abs(nrm - 1.0) > 1e-12:
+        if scalings is not None:
+            scalings = tuple(np.asarray(X, dtype=complex) for X in scalings)
+        low = mu_lower(M / nrm, structure, rng=rng, scalings=scalings)
+        if low.Delta is None or low.value == 0:
+            return low
+        Delta = low.Delta / nrm
+        res = float(np.linalg.svd(np.eye(structure.ncols) - M @ Delta, compute_uv=False)[-1])
+        return MuLower(float(low.value * nrm), Delta, low.method, res)
     rng = np.random.default_rng(rng)
     S = structure
     if not S.has_real:
@@ -1420,6 +1503,7 @@ def mu_bounds(M, structure: BlockStructure, *, method: str = "lmi", real: str = 
     """Both bounds: :func:`mu_lower`, then :func:`mu_upper` with the lower bound
     starting its bisection, then (complex structures, if they differ) the lower
     bound again from the upper bound's scalings."""
+    structure = _as_structure(structure)
     up, lo = _both(structure.check(M), structure, method, real, np.random.default_rng(rng))
     return MuBounds(up, lo)
 
@@ -1559,7 +1643,14 @@ def mu_sweep(sys, structure: BlockStructure, omega=None, *, method: str = "osbor
         frequencies, an unknown ``lower``, a response that is singular or not
         finite on the grid (a pole on the imaginary axis).
     """
+    structure = _as_structure(structure)
     _, sysss = _freqresp_fn(sys)
+    poles = _poles(sysss)
+    unstable = poles[poles.real > 1e-9 * np.maximum(np.abs(poles), 1e-300)] if poles.size else poles
+    if unstable.size:
+        raise IllPosedError("mu_sweep needs a stable system M(s) (mu of the frequency response says nothing "
+                            "about robust stability when the nominal loop is unstable); unstable pole(s) at s = "
+                            + ", ".join(f"{p:.6g}" for p in unstable[:6]))
     if sysss.noutputs != structure.ncols or sysss.ninputs != structure.nrows:
         raise ModelError(f"the system has {sysss.noutputs} outputs and {sysss.ninputs} inputs; the "
                          f"block structure {structure!r} needs {structure.ncols} outputs and "

@@ -357,14 +357,24 @@ def write_frf(path, frf: FRF, *, output_unit: str = "m") -> Path:
             if not isinstance(v, str) or not v.strip() or _breaks_line(v):
                 raise ModelError(f"write_frf {path}: {key} {v!r} cannot be written on one header line")
             lines.append(f"# {key}: {v.strip()}")
+    written = {"input_station", "input_quantity", "input_unit", "output_station", "output_quantity",
+               "output_unit", "speed_hz", "input_direction", "output_direction", "input_name", "output_name",
+               "file_output_unit", "file_input_unit"} | set(_RESERVED)
     for k, v in frf.metadata.items():
         if k in ("file_output_unit", "file_input_unit") or k in _RESERVED:
             continue
         k, v = str(k), str(v)
-        if ":" in k or _breaks_line(k) or _breaks_line(v) or not k.strip() or k.strip().startswith("#"):
+        ks = k.strip()
+        if ":" in k or _breaks_line(k) or _breaks_line(v) or not ks or ks.startswith("#") \
+                or "\x00" in k or "\x00" in v:
             raise ModelError(f"write_frf {path}: metadata key {k!r} / value {v!r} cannot be "
                              f"written as a '# key: value' line")
-        lines.append(f"# {k.strip()}: {v.strip()}")
+        if ks in written:
+            raise ModelError(f"write_frf {path}: metadata key {k!r} would be written as '{ks}', which "
+                             f"is {'a reserved key' if ks in _RESERVED else 'already written'}; the file "
+                             f"could not be read back")
+        written.add(ks)
+        lines.append(f"# {ks}: {v.strip()}")
     lines.append(CSV_HEADER)
     G = frf.response_in(output_unit)
     for f, g in zip(frf.freq_hz, G):

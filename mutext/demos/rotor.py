@@ -41,7 +41,19 @@ def _peaks(f, mag):
 
 def solve(model_path=None, *, n_modes=6, points=400, band=(20.0, 225.0)):
     """Everything the demo reports, as a dict (SI; frequencies in Hz)."""
+    from ..errors import ModelError
     from ..rotor import data_path, load_model
+    for name, v, lo in (("--modes (n_modes)", n_modes, 1), ("--points (points)", points, 2)):
+        if isinstance(v, (bool, np.bool_)) or not isinstance(v, (int, np.integer)) or v < lo:
+            raise ModelError(f"{name} must be an integer >= {lo}, got {v!r}")
+    if points > 1_000_000:
+        raise ModelError(f"--points (points) must be at most 1000000, got {points}")
+    try:
+        lo_hz, hi_hz = (float(x) for x in band)
+    except (TypeError, ValueError):
+        raise ModelError(f"band must be two frequencies (Hz), got {band!r}") from None
+    if not (np.isfinite(lo_hz) and np.isfinite(hi_hz) and 0 <= lo_hz < hi_hz):
+        raise ModelError(f"band must satisfy 0 <= low < high (finite, Hz), got {band!r}")
     t0 = time.perf_counter()
     model_path = model_path or data_path("rotor.toml")
     rotors = {"healthy": load_model(model_path),
@@ -106,7 +118,15 @@ def save_plots(out, directory):
     import matplotlib
     matplotlib.use("Agg", force=False)
     import matplotlib.pyplot as plt
-    os.makedirs(directory, exist_ok=True)
+    from ..errors import ModelError
+    try:
+        os.makedirs(directory, exist_ok=True)
+        probe = os.path.join(directory, ".mutext_write_test")
+        with open(probe, "w"):
+            pass
+        os.remove(probe)
+    except OSError as exc:
+        raise ModelError(f"--plots {directory!r}: cannot write plots there ({exc.strerror or exc})") from None
     f = out["freqs_hz"]
     fig, (a1, a2) = plt.subplots(2, 1, sharex=True, figsize=(7, 6))
     for key, style in (("healthy", "-"), ("cracked", "--")):

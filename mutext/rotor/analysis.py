@@ -50,7 +50,7 @@ from typing import Sequence
 import numpy as np
 import scipy.linalg as sla
 
-from ..errors import ModelError
+from ..errors import IllPosedError, ModelError
 from ..lti import blas_single_thread, mck_to_ss
 from ..response import FRFMatrix
 
@@ -134,10 +134,44 @@ def whirl_index(shape: np.ndarray, layout) -> float:
     return float(-2.0 * np.sum(np.imag(np.conj(u) * v)) / den)
 
 
+def _check_n(n, what="n"):
+    """``n`` (number of modes) as an int >= 1, or a ModelError naming it (a negative n
+    used to slice modes away silently)."""
+    if n is None:
+        return None
+    if isinstance(n, (bool, np.bool_)) or not isinstance(n, (int, np.integer)) or n < 1:
+        raise ModelError(f"{what} (number of modes) must be a positive integer or None, got {n!r}")
+    return int(n)
+
+
+def _values(model, values):
+    """``model.values(values)`` checked: every parameter a finite number (a NaN used to
+    surface as a scipy ValueError from deep inside the assembly)."""
+    try:
+        v = model.values(values)
+    except (TypeError, ValueError) as exc:
+        if isinstance(exc, ModelError):
+            raise
+        raise ModelError(f"{model.name}: bad parameter values {values!r} ({exc})") from None
+    v = np.asarray(v, dtype=float)
+    bad = ~np.isfinite(v)
+    if bad.any():
+        names = [p.name for p in model.parameters]
+        i = int(np.flatnonzero(bad)[0])
+        raise ModelError(f"{model.name}: parameter '{names[i] if i < len(names) else i}' has the non-finite "
+                         f"value {v[i]}")
+    return v
+
+
 def _speed(model, speed):
     if speed is None:
         return float(getattr(model, "speed", 0.0))
-    speed = float(speed)
+    try:
+        speed = float(speed)
+    except (TypeError, ValueError):
+        raise ModelError(f"{model.name}: speed must be a number (rad/s), got {speed!r}") from None
+    if not np.isfinite(speed):
+        raise ModelError(f"{model.name}: speed must be finite (rad/s), got {speed!r}")
     if speed != 0.0 and getattr(model.layout, "kind", "") != "rotor":
         raise ModelError(f"{model.name}: a nonzero speed needs a two-plane rotor model (planes=2)")
     return speed
@@ -161,6 +195,11 @@ def modes(model, *, speed: float | None = None, values=None, n: int | None = Non
     matrices : Matrices, optional
         Precomputed ``model.matrices(values)``.
     """
+    n = _check_n(n)
+    if not (isinstance(rigid_tol, (int, float, np.integer, np.floating)) and 0 <= rigid_tol < 1):
+        raise ModelError(f"rigid_tol must lie in [0, 1), got {rigid_tol!r}")
+    if matrices is None:
+        values = _values(model, values)
     with blas_single_thread():
         return _modes(model, _speed(model, speed), values, n, rigid_tol, matrices)
 
@@ -174,9 +213,14 @@ def _modes(model, speed, values, n, rigid_tol, matrices) -> Modes:
     except np.linalg.LinAlgError:
         raise ModelError(f"{model.name}: the mass matrix is not positive definite (every DOF needs mass "
                          "or rotary inertia)") from None
+    for name, X in (("mass", M), ("damping", D), ("stiffness", K)):
+        if not np.all(np.isfinite(X)):
+            raise ModelError(f"{model.name}: the {name} matrix has non-finite entries (check the parameter values)")
     if not np.any(D):
         lam, Phi = sla.eigh(0.5 * (K + K.T), M)
         scale = max(float(np.max(np.abs(lam))), 1e-300)
+        if lam.min() < -rigid_tol**2 * scale:
+            raise IllPosedError(_divergence(model, np.sqrt(-lam[lam < -rigid_tol**2 * scale])))
         keep = lam > rigid_tol**2 * scale
         w = np.sqrt(lam[keep])
         ev = 1j * w
@@ -187,6 +231,9 @@ def _modes(model, speed, values, n, rigid_tol, matrices) -> Modes:
         A = np.block([[np.zeros((ndof, ndof)), np.eye(ndof)], [-Minv @ K, -Minv @ D]])
         lam, X = sla.eig(A)
         scale = max(float(np.max(np.abs(lam))), 1e-300)
+        diverging = lam[(np.abs(lam.imag) <= rigid_tol * scale) & (lam.real > rigid_tol * scale)]
+        if diverging.size:
+            raise IllPosedError(_divergence(model, diverging.real))
         keep = lam.imag > rigid_tol * scale
         ev = lam[keep]
         order = np.argsort(ev.imag)
@@ -204,6 +251,13 @@ def _modes(model, speed, values, n, rigid_tol, matrices) -> Modes:
     return Modes(ev, w, w / (2 * np.pi), zeta, shapes, whirl, speed, model.dof_names)
 
 
+def _divergence(model, rates) -> str:
+    return (f"{model.name}: the model is statically unstable (divergent): {rates.size} mode(s) grow without "
+            f"oscillating (growth rate up to {float(np.max(rates)):.4g} 1/s); the stiffness "
+            "matrix is not positive semidefinite -- check the parameter values (a negative Young's modulus, "
+            "bearing or spring stiffness); natural frequencies of such a model would be meaningless")
+
+
 def natural_frequencies(model, *, speed: float | None = None, values=None, n: int | None = None,
                         matrices=None) -> np.ndarray:
     """Damped natural frequencies [Hz] (rigid-body modes left out), lowest first."""
@@ -216,7 +270,14 @@ def campbell(model, speeds: Sequence[float], *, n: int = 6, values=None) -> Camp
     The matrices are evaluated once; modes are sorted by frequency at each
     speed (no mode tracking across crossings).
     """
-    speeds = np.atleast_1d(np.asarray(speeds, dtype=float))
+    try:
+        speeds = np.atleast_1d(np.asarray(speeds, dtype=float))
+    except (TypeError, ValueError):
+        raise ModelError(f"{model.name}: speeds must be numbers (rad/s), got {speeds!r}") from None
+    if speeds.ndim != 1 or speeds.size == 0 or not np.all(np.isfinite(speeds)):
+        raise ModelError(f"{model.name}: speeds must be a non-empty 1-D array of finite numbers (rad/s)")
+    n = _check_n(n)
+    values = _values(model, values)
     with blas_single_thread():
         mats = model.matrices(values)
     F = np.full((speeds.size, n), np.nan)
@@ -253,10 +314,30 @@ def frf(model, freqs_hz, *, inputs: Sequence[str] | None = None, outputs: Sequen
     """
     speed = _speed(model, speed)
     ins, outs = _ports(model, inputs, outputs)
-    f = np.atleast_1d(np.asarray(freqs_hz, dtype=float))
-    v = model.values(values)
+    try:
+        f = np.atleast_1d(np.asarray(freqs_hz, dtype=float))
+    except (TypeError, ValueError):
+        raise ModelError(f"{model.name}: freqs_hz must be numbers (Hz), got {freqs_hz!r}") from None
+    if f.ndim != 1 or f.size == 0:
+        raise ModelError(f"{model.name}: freqs_hz must be a non-empty 1-D array of frequencies (Hz)")
+    bad = ~np.isfinite(f) | (f < 0) | (f > 1e100)
+    if bad.any():
+        i = int(np.flatnonzero(bad)[0])
+        raise ModelError(f"{model.name}: freqs_hz[{i}] = {f[i]} Hz; frequencies must be finite, "
+                         "non-negative and at most 1e100 Hz")
+    v = _values(model, values)
     with blas_single_thread():
-        return _frf(model, f, ins, outs, speed, v)
+        try:
+            out = _frf(model, f, ins, outs, speed, v)
+        except np.linalg.LinAlgError:
+            raise ModelError(f"{model.name}: the dynamic stiffness is singular at one of the requested "
+                             "frequencies (an undamped resonance, or a rigid-body mode at 0 Hz, hit exactly)") from None
+    if not np.all(np.isfinite(out.H)):
+        k = int(np.flatnonzero(~np.isfinite(out.H).all(axis=(0, 1)))[0])
+        raise ModelError(f"{model.name}: the frequency response at {f[k]:.6g} Hz is not finite (the dynamic "
+                         "stiffness is singular or overflows there: an undamped resonance or rigid-body mode "
+                         "hit exactly, or an absurd frequency)")
+    return out
 
 
 def _frf(model, f, ins, outs, speed, v) -> FRF:
@@ -298,7 +379,7 @@ def state_space(model, *, inputs: Sequence[str] | None = None, outputs: Sequence
     """
     speed = _speed(model, speed)
     ins, outs = _ports(model, inputs, outputs)
-    v = model.values(values)
+    v = _values(model, values)
     with blas_single_thread():
         M, C, K, G = model.matrices(v)
     B = model.input_matrix(v)

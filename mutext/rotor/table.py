@@ -248,10 +248,22 @@ def parse_station_table(text: str, source: str = "<string>") -> StationTable:
 
 def read_station_table(path: str | os.PathLike) -> StationTable:
     """Read a station table file (see :func:`parse_station_table`)."""
-    path = os.fspath(path)
     try:
-        with open(path, encoding="utf-8") as fh:
-            text = fh.read()
+        path = os.fspath(path)
+    except TypeError:
+        raise ModelError(f"station table path must be a str or path-like, got {path!r}") from None
+    try:
+        with open(path, "rb") as fh:
+            raw = fh.read()
     except OSError as exc:
-        raise ModelError(f"cannot read station table '{path}': {exc.strerror}") from None
+        raise ModelError(f"cannot read station table '{path}': {exc.strerror or exc}") from None
+    if b"\x00" in raw:
+        raise ModelError(f"{path}: binary file (it contains NUL bytes, e.g. UTF-16 text); a station table is "
+                         "UTF-8 (or ASCII) text")
+    try:
+        text = raw.decode("utf-8-sig")
+    except UnicodeDecodeError as exc:
+        line = raw[:exc.start].count(b"\n") + 1
+        raise ModelError(f"{path}, line {line}: not UTF-8 text (byte 0x{raw[exc.start]:02x}); save the station "
+                         "table as UTF-8 or ASCII") from None
     return parse_station_table(text, source=path)
