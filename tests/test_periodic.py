@@ -140,3 +140,11 @@ def test_bad_input_is_named():
         analyzer_frf(pr, [float("nan")])
     with pytest.raises(ModelError, match="cutoff"):
         pr.reduce(-5.0)
+
+
+def test_crack_quadrature_points_are_checked():
+    from mutext.rotor.crack import crack_compliance_dimensionless
+    with pytest.raises(ModelError, match="n_quad"):
+        rotor("[[crack]]\nstation = 15\ndepth_ratio = 0.4\nn_quad = 0\n")
+    with pytest.raises(ModelError, match="n_quad"):
+        crack_compliance_dimensionless(0.3, n_quad=0)

@@ -88,6 +88,13 @@ def test_diagnose_reports_sidebands_for_data_taken_at_speed():
     assert res.verdict.kind == "crack" and res.verdict.station == 15
     assert res.sidebands["verdict"] == "once per revolution"
     assert "sidebands" in res.report() and res.as_dict()["sidebands"]["orders_found"]
+    # ... and the crack that turns with the shaft is fitted: its depth, at the noise, better held out
+    b = res.breathing
+    assert b["station"] == 15 and b["law"] == "mayes"
+    assert abs(b["depth_ratio"] - 0.4) < max(3 * b["depth_std"], 0.01)
+    assert b["misfit_left"] < 1.5
+    assert b["held_out_error"]["rel"] < 0.5 * b["time_invariant_crack"]["held_out_error"]["rel"]
+    assert "turns with the shaft" in res.report()
     # a bearing change at speed: no sidebands
     bear = rotor(text=TEXT.replace("stiffness = 1.0e7", "stiffness = 0.8e7", 1))
     res = diagnose(data_path("rotor.toml"), [sweep(bear, seed=6, noise=1e-3)], refit=1,

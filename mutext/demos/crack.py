@@ -159,21 +159,34 @@ def solve(depth: float = 0.4, law: str = "mayes", noise: float = 0.001, seed: in
         "freqs_hz": f, "measured": measured.response, "engineering": He, "controlled": Hc,
         "K": K, "D_rig": D_rig, "D_mean": D_mean,
     }
+    result.update(engineering_system=E, first_mode_mask=band1)
     if thesis_tables:
-        table = ex.thesis_cracked_table_rotor()
-        tm = measure(table.state_space(inputs=[ex.EXCITATION], outputs=[ex.MEASUREMENT]), ex.EXCITATION,
-                     ex.MEASUREMENT, f, noise=noise, rng=seed)
-        tm.input_name, tm.output_name = ex.EXCITATION, ex.MEASUREMENT
         say("thesis data path: cracked station table (density, disk mass) as the true system")
-        rt = _identify(tm, E, out)
-        Kt = freqresp(rt.K, w)[0, 0]
-        result["thesis_tables"] = {
-            "mu": rt.mu_upper, "Wz": rt.Wz, "K_order": int(rt.K.nstates), "K_reading": rt.fit.description,
-            "K_peaks_hz": _k_peaks(rt.K, f), "K_at_first_mode": -float(np.median(Kt[band1].real)),
-            "fit_error_before": _rel_rms(He, tm.response),
-            "fit_error_after": _rel_rms(freqresp(rt.controlled, w)[0, 0], tm.response), "K": Kt}
+        result["thesis_tables"] = thesis_tables_path(result, out=out)
     result["seconds"] = time.perf_counter() - t0
     return result
+
+
+def thesis_tables_path(result, *, out=None) -> dict:
+    """The thesis's own data path: its cracked station table (density and disk mass tuned by hand,
+    no crack element) as the true system, against the same engineering model as ``result``
+    (a dict of :func:`solve`), with the same noise."""
+    from ..lti import freqresp
+    from ..rig import measure
+    f = result["freqs_hz"]
+    w = 2 * np.pi * f
+    rig = result["rig"]
+    table = ex.thesis_cracked_table_rotor()
+    tm = measure(table.state_space(inputs=[ex.EXCITATION], outputs=[ex.MEASUREMENT]), ex.EXCITATION,
+                 ex.MEASUREMENT, f, noise=rig["noise"], rng=rig["seed"])
+    tm.input_name, tm.output_name = ex.EXCITATION, ex.MEASUREMENT
+    rt = _identify(tm, result["engineering_system"], out)
+    Kt = freqresp(rt.K, w)[0, 0]
+    return {"mu": rt.mu_upper, "Wz": rt.Wz, "K_order": int(rt.K.nstates), "K_reading": rt.fit.description,
+            "K_peaks_hz": _k_peaks(rt.K, f), "K_at_first_mode": -float(np.median(Kt[result["first_mode_mask"]].real)),
+            "fit_error_before": _rel_rms(result["engineering"], tm.response),
+            "fit_error_after": _rel_rms(freqresp(rt.controlled, w)[0, 0], tm.response),
+            "notes": list(rt.notes), "K": Kt}
 
 
 JSON_KEYS = ("mu", "mu_lower", "Wz", "K_order", "equivalent_stiffness_loss", "identified_stiffness_loss",

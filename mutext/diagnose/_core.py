@@ -143,6 +143,11 @@ def diagnose(model, frfs, validate=None, *, alpha: float = 0.01, refit: int = 3,
                        time.perf_counter() - t0, notes, N)
     if speed > 0 and hasattr(eng, "n_stations"):
         result.sidebands = _sidebands(eng, speed, chans, verdict, result.notes)
+        if result.sidebands and result.sidebands["verdict"] != "none" and model_text is not None:
+            tell("a crack that turns with the shaft, at the best crack station (time-periodic fit)", 0.96)
+            result.breathing = _breathing(findings, result.sidebands, model_text, path, speed, chans, fit,
+                                          held, s2, rss0, verdict, err_after, result.notes)
+            result.seconds = time.perf_counter() - t0
     if mbi and verdict is not none:
         tell("model-based identification at the finding (D-K iteration)", 0.97)
         try:
@@ -155,6 +160,27 @@ def diagnose(model, frfs, validate=None, *, alpha: float = 0.01, refit: int = 3,
         write_model(result, out_dir)
     tell("done", 1.0)
     return result
+
+
+def _breathing(findings, sidebands, model_text, path, speed, chans, fit, held, s2, rss0, verdict, err_after,
+               notes):
+    """Depth of a turning crack at the best crack station, when the sidebands call for one."""
+    from ._breathing import fit_breathing_crack
+    cracks = [f for f in findings if f.kind == "crack" and f.station is not None]
+    if not cracks:
+        return None
+    best = min(cracks, key=lambda f: f.score)
+    laws = ("mayes", "gasch") if sidebands["verdict"] == "once per revolution" else ("open",)
+    try:
+        out = fit_breathing_crack(model_text, os.path.dirname(os.path.abspath(path)) if path else ".",
+                                  best.station, speed, chans, fit, held, s2, laws,
+                                  rss0 - best.delta_chi2 * s2)
+    except ModelError as exc:
+        notes.append(f"a breathing crack was not fitted: {exc}")
+        return None
+    out["time_invariant_crack"] = {"depth_ratio": best.value, "depth_std": best.std,
+                                   "held_out_error": err_after if verdict is best else None}
+    return out
 
 
 def _sidebands(eng, speed, chans, verdict, notes):

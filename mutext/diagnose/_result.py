@@ -120,6 +120,7 @@ class Diagnosis:
     extended_model: str | None = None
     mbi: dict | None = None
     sidebands: dict | None = None   # sideband evidence when the data were taken at speed (rotors)
+    breathing: dict | None = None   # a crack that turns with the shaft, fitted when the sidebands call for it
 
     def as_dict(self) -> dict:
         return {
@@ -138,6 +139,7 @@ class Diagnosis:
             "extended_model": self.extended_model,
             "mbi": self.mbi,
             "sidebands": self.sidebands,
+            "breathing": self.breathing,
             "notes": self.notes,
             "seconds": self.seconds,
         }
@@ -184,6 +186,11 @@ class Diagnosis:
                        f"{size + sd:>24} {f.delta_chi2:>11.1f} {self.misfit_left(f):>11.3g}")
         out.append("")
         out.append(f"verdict: {self.verdict.sentence()}")
+        if self.breathing:
+            b = self.breathing
+            out.append(f"  at speed: the crack turns with the shaft and breathes ({b['law']} law), a/D = "
+                       f"{b['depth_ratio']:.4g} +/- {b['depth_std']:.2g} (details below; the time-invariant "
+                       "finding is its revolution average)")
         if self.ambiguous_with:
             names = "; ".join(f"{f.kind} at {f.station} ({f.element})" for f in self.ambiguous_with)
             out.append(f"  cannot be told apart from: {names}")
@@ -208,6 +215,21 @@ class Diagnosis:
             out.append(f"sidebands (data taken at {sb['speed_hz']:.4g} Hz): {sb['verdict']}: {sb['meaning']}"
                        + ("" if not found else "; at " + ", ".join(
                            f"{c['freq_hz']:.1f} Hz (k={c['k']:+d})" for c in found[:6])))
+        if self.breathing:
+            b = self.breathing
+            ti = b["time_invariant_crack"]
+            line = (f"crack turning with the shaft ({b['law']} breathing) in the {b['element']}: a/D = "
+                    f"{b['depth_ratio']:.4g} +/- {b['depth_std']:.2g} (time-invariant crack there: "
+                    f"a/D {ti['depth_ratio']:.4g}); misfit left {b['misfit_left']:.3g}")
+            if b["delta_chi2_vs_time_invariant"] is not None:
+                line += f", delta chi2 {b['delta_chi2_vs_time_invariant']:.1f} over the time-invariant crack"
+            out.append(line)
+            he = b["held_out_error"]
+            tie = ti.get("held_out_error")
+            out.append(f"  held-out: {100 * he['rel']:.3g} % rms complex error"
+                       + ("" if not tie else f" (time-invariant crack: {100 * tie['rel']:.3g} %)")
+                       + f"; projection error of the reduced rotor {b['projection_error']:.1g}; {b['seconds']:.0f} s")
+            out.append("  add to the model file: " + b["model_addition"].strip().replace("\n", "; "))
         if self.extended_model:
             out.append(f"extended model: {self.extended_model}")
         for n in self.notes:

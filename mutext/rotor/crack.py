@@ -251,6 +251,8 @@ def crack_compliance_dimensionless(depth_ratio, *, n_quad: int = 16):
     derivative with respect to depth vanishes at zero depth; the expression
     is evaluated as exactly 0 there (its derivative there is returned as 0).
     """
+    if isinstance(n_quad, bool) or not isinstance(n_quad, (int, np.integer)) or not 1 <= n_quad <= 200:
+        raise ModelError(f"n_quad must be an integer number of Gauss points in 1..200, got {n_quad!r}")
     f = _cbar_function(int(n_quad))
     if isinstance(depth_ratio, ca.DM):
         depth_ratio = np.array(depth_ratio, dtype=float).squeeze()
@@ -911,6 +913,9 @@ def _make_crack_class():
                                  f"got {orientation!r}")
             self.orientation = orientation
             self.xi = float(xi)
+            if isinstance(n_quad, bool) or not isinstance(n_quad, (int, np.integer)) or not 1 <= n_quad <= 200:
+                raise ModelError(f"{self.name}: n_quad must be an integer number of Gauss points in 1..200, "
+                                 f"got {n_quad!r}")
             self.n_quad = int(n_quad)
             self.host = None
 

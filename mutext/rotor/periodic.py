@@ -204,14 +204,8 @@ class PeriodicRotor:
             Q, R = np.linalg.qr(V)
             V = V[:, np.abs(np.diag(R)) > 1e-10 * np.max(np.abs(np.diag(R)))]
             lr, W = sla.eigh(V.T @ K0 @ V, V.T @ self.M @ V)
-        P = V @ W
-
-        def proj(X):
-            return P.T @ X @ P
-
-        red = replace(self, M=np.eye(P.shape[1]), D=proj(self.D), K_healthy=proj(self.K_healthy),
-                      cracks=[replace(c, A=tuple(proj(a) for a in c.A)) for c in self.cracks],
-                      B=P.T @ self.B, Cy=self.Cy @ P, basis=P, cutoff_hz=float(cutoff_hz))
+        red = self.project(V @ W)
+        red.cutoff_hz = float(cutoff_hz)
         lo, hi = float(band_hz[0]), float(band_hz[1])
         if not (0 < lo < hi):
             raise ModelError(f"band_hz must be (low, high) with 0 < low < high, got {band_hz!r}")
@@ -223,6 +217,26 @@ class PeriodicRotor:
         red.reduction_error = float(max(err))
         red.reduction_band_hz = (float(f[0]), float(f[-1]))
         return red
+
+
+def _project(self, P) -> "PeriodicRotor":
+    """The model on the mass-orthonormal basis ``P`` (``ndof x r``, e.g. the ``basis`` of a
+    reduction of a neighbouring model: the same rotor with another crack depth)."""
+    if self.basis is not None:
+        raise ModelError(f"{self.name}: the model is already reduced")
+    P = np.asarray(P, float)
+    if P.ndim != 2 or P.shape[0] != self.n:
+        raise ModelError(f"{self.name}: a basis needs {self.n} rows, got shape {P.shape}")
+
+    def proj(X):
+        return P.T @ X @ P
+
+    return replace(self, M=proj(self.M), D=proj(self.D), K_healthy=proj(self.K_healthy),
+                   cracks=[replace(c, A=tuple(proj(a) for a in c.A)) for c in self.cracks],
+                   B=P.T @ self.B, Cy=self.Cy @ P, basis=P, reduction_error=None, reduction_band_hz=None)
+
+
+PeriodicRotor.project = _project
 
 
 def _rel_err(H, ref) -> float:
@@ -453,12 +467,13 @@ def _rk4_propagators(pr: PeriodicRotor, P: int, h: float, input_index: int):
     t = np.arange(P) * h
     stages = np.stack([t + eps, t + 0.5 * h, t + h - eps], axis=1)      # (P, 3)
     K = pr.stiffness_at(pr.speed * stages.ravel()).reshape(P, 3, r, r)
+    Mi = np.linalg.inv(pr.M)          # the identity on a mass-orthonormal basis
     A = np.zeros((P, 3, 2 * r, 2 * r))
     A[:, :, :r, r:] = np.eye(r)
-    A[:, :, r:, :r] = -K
-    A[:, :, r:, r:] = -pr.D
+    A[:, :, r:, :r] = -Mi @ K
+    A[:, :, r:, r:] = -Mi @ pr.D
     b = np.zeros(2 * r)
-    b[r:] = pr.B[:, input_index]
+    b[r:] = Mi @ pr.B[:, input_index]
     I = np.eye(2 * r)
 
     def step(z, b0, bh, b1):
