@@ -100,3 +100,24 @@ def test_diagnose_reports_sidebands_for_data_taken_at_speed():
     res = diagnose(data_path("rotor.toml"), [sweep(bear, seed=6, noise=1e-3)], refit=1,
                    only=lambda h: h.kind in ("crack", "bearing", "stiffness") and h.station in (2, 15))
     assert res.sidebands["verdict"] == "none"
+
+
+@pytest.mark.slow
+def test_diagnose_breathing_crack_from_time_integrated_data():
+    # data from the brute-force analyzer (time integration, the breathing law evaluated at every
+    # step), not from the harmonic balance the diagnosis fits with
+    from mutext.diagnose import diagnose
+    from mutext.rig import measure, sweep_frequencies
+    from mutext.rotor.periodic import periodic_rotor, stepped_sine
+    f = sweep_frequencies()
+    pr = periodic_rotor(crack("mayes"), inputs=["i12"], outputs=["x13"]).reduce(1000.0)
+    td = stepped_sine(pr, f, settle_s=4.0, revolutions=10)
+    d = measure(lambda w: td["H"], 0, 0, f, noise=1e-3, rng=9, input_station=12, output_station=13,
+                input_quantity="current", speed_hz=SPEED_HZ)
+    d.input_name, d.output_name = "i12", "x13"
+    res = diagnose(data_path("rotor.toml"), [d], refit=1,
+                   only=lambda h: h.kind in ("crack", "stiffness") and h.station in (5, 15, 24))
+    assert res.sidebands["verdict"] == "once per revolution"
+    b = res.breathing
+    assert b["station"] == 15 and abs(b["depth_ratio"] - 0.4) < 0.01
+    assert b["misfit_left"] < 2.0
