@@ -259,6 +259,15 @@ class BlockStructure:
         M = M.astype(complex)
         if not np.all(np.isfinite(M)):
             raise ModelError("M contains non-finite entries")
+        # subnormal parts (below 2.2e-308) next to normal entries: zero them.  mu moves by about
+        # 1e-308 relative, and the scalings would otherwise meet numbers that some loaded
+        # libraries make the CPU read as zero (0/0 inside the SVD)
+        tiny = np.finfo(float).tiny
+        if np.abs(M).max(initial=0.0) >= tiny:
+            re, im = M.real.copy(), M.imag.copy()
+            re[np.abs(re) < tiny] = 0.0
+            im[np.abs(im) < tiny] = 0.0
+            M = re + 1j * im
         return M
 
     # -- perturbations -----------------------------------------------------
@@ -358,6 +367,11 @@ def _norm2(M) -> float:
     amax = float(np.abs(M).max(initial=0.0))
     if amax == 0 or not np.isfinite(amax):
         return amax
+    if amax < np.finfo(float).tiny:
+        # subnormal numbers: some loaded libraries set the CPU to read them as zero, so no
+        # arithmetic on them can be trusted
+        raise ModelError(f"M's entries are all subnormal (largest {amax:.3g} < {np.finfo(float).tiny:.3g}): "
+                         "scale M up (mu(cM) = |c| mu(M))")
     with np.errstate(over="ignore"):
         return float(np.linalg.norm(M / amax, 2) * amax)
 
@@ -1065,7 +1079,8 @@ class MuLower:
     method : str
         ``"sigma"`` (one full block), ``"power"`` (complex power iteration),
         ``"real-eig"`` (one real block: exact), ``"real-local"`` (real blocks
-        only: local search) or ``"real-search"`` (real and complex blocks).
+        only: local search), ``"real-search"`` (real and complex blocks) or
+        ``"failed"`` (the search broke down numerically; the bound is then 0).
     residual : float
         Smallest singular value of :math:`I - M\Delta` (should be ~0).
     """
@@ -1444,21 +1459,28 @@ def mu_lower(M, structure: BlockStructure, *, rng=0, scalings=None) -> MuLower:
         return MuLower(float(low.value * nrm), Delta, low.method, res)
     rng = np.random.default_rng(rng)
     S = structure
-    if not S.has_real:
-        Q0 = None
-        if scalings is not None:
-            Dl, Dr = (np.asarray(X, dtype=complex) for X in scalings)
-            if Dl.shape != (S.ncols, S.ncols) or Dr.shape != (S.nrows, S.nrows):
-                raise ModelError(f"scalings must be (Dl, Dr) of sizes {S.ncols}x{S.ncols} and "
-                                 f"{S.nrows}x{S.nrows}, got {Dl.shape} and {Dr.shape}")
-            Q0 = _start_from_scalings(M, S, Dl, Dr)
-        v, Delta = _complex_lower(M, S, rng, Q0=Q0)
-        method = "sigma" if len(S) == 1 and S.blocks[0].kind == "full" else "power"
-    elif all(b.kind == "real" for b in S.blocks):
-        v, Delta, method = _real_only_lower(M, S, rng)
-    else:
-        v, Delta, method = _mixed_lower(M, S, rng)
-    if Delta is None or v == 0:
+    Q0 = None
+    if not S.has_real and scalings is not None:
+        Dl, Dr = (np.asarray(X, dtype=complex) for X in scalings)
+        if Dl.shape != (S.ncols, S.ncols) or Dr.shape != (S.nrows, S.nrows):
+            raise ModelError(f"scalings must be (Dl, Dr) of sizes {S.ncols}x{S.ncols} and "
+                             f"{S.nrows}x{S.nrows}, got {Dl.shape} and {Dr.shape}")
+    try:
+        with np.errstate(all="ignore"):
+            if not S.has_real:
+                if scalings is not None:
+                    Q0 = _start_from_scalings(M, S, Dl, Dr)
+                v, Delta = _complex_lower(M, S, rng, Q0=Q0)
+                method = "sigma" if len(S) == 1 and S.blocks[0].kind == "full" else "power"
+            elif all(b.kind == "real" for b in S.blocks):
+                v, Delta, method = _real_only_lower(M, S, rng)
+            else:
+                v, Delta, method = _mixed_lower(M, S, rng)
+    except (np.linalg.LinAlgError, ValueError, FloatingPointError):
+        # the iterations can overflow on matrices whose entries span hundreds of decades even
+        # after normalisation; a search that breaks down proves nothing, and 0 is a valid bound
+        return MuLower(0.0, None, "failed", np.nan)
+    if Delta is None or v == 0 or not np.all(np.isfinite(Delta)):
         return MuLower(0.0, None, method, np.nan)
     res = float(np.linalg.svd(np.eye(S.ncols) - M @ Delta, compute_uv=False)[-1])
     # tolerance of the singularity test: rounding in forming I - M Delta

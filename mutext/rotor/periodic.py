@@ -24,7 +24,11 @@ harmonic balance gives, for :math:`k = -N..N` (truncated),
     Z(\nu) = K_0 - \nu^2 M + j\nu(C + \Omega G),
 
 a block system of size :math:`(2N+1)\,n` per frequency
-(:func:`harmonic_response`).  :math:`H_k = C_y Q_k` are the harmonic
+(:func:`harmonic_response`).  For the smooth laws the truncation converges
+fast (Mayes: :math:`2.5\cdot10^{-6}` at the default N = 6 on the thesis
+rotor); the Gasch switch has harmonics decaying like :math:`1/m` and
+converges like :math:`1/N` (0.4 % at N = 24, 0.1 % at N = 64 near the second
+mode).  :math:`H_k = C_y Q_k` are the harmonic
 transfer functions ([Wer91]_): :math:`H_0` is what reaches the excitation
 frequency, :math:`H_{k \ne 0}` the sidebands at :math:`\omega + k\Omega`.
 
