@@ -80,7 +80,7 @@ def convergence(red):
 def detection(seeds: int):
     from mutext.diagnose import sideband_evidence
     from mutext.examples.cracked_rotor import cracked_rotor, healthy_rotor
-    from mutext.rig import measure, measure_rotor
+    from mutext.rig import measure_rotor, with_noise
     from mutext.rotor import data_path, loads_model
     text = open(data_path("rotor.toml")).read()
     cases = {"breathing (mayes)": (cracked_rotor(), "once per revolution"),
@@ -97,7 +97,7 @@ def detection(seeds: int):
         for noise in (5e-4, 1e-3, 5e-3):
             ok = 0
             for s in range(seeds):
-                d = measure(lambda w: exact[k].response, 0, 0, exact[k].freq_hz, noise=noise, rng=100 + s)
+                d = with_noise(exact[k], noise, rng=100 + s)
                 ok += sideband_evidence(d, modes, 10.0).verdict == want
             fr.append(ok / seeds)
         print(f"   {k:<20} {want:<22} {fr[0]:>13.2f} {fr[1]:>12.2f} {fr[2]:>12.2f}")

@@ -32,7 +32,8 @@ import numpy as np
 
 from .errors import ModelError
 
-__all__ = ["FRF", "FRFMatrix", "sweep_frequencies", "INPUT_UNITS", "OUTPUT_UNITS", "DIRECTIONS"]
+__all__ = ["FRF", "FRFMatrix", "sweep_frequencies", "local_extrema", "INPUT_UNITS", "OUTPUT_UNITS",
+           "DIRECTIONS"]
 
 #: Allowed input quantities and their unit (the SI unit; factor to SI is 1).
 INPUT_UNITS: dict[str, dict[str, float]] = {"force": {"N": 1.0}, "current": {"A": 1.0}}
@@ -210,6 +211,16 @@ class FRFMatrix:
                         self.ports.get(o, (None, "x", "displacement"))[2] in OUTPUT_UNITS:
                     out.append(self.channel(o, i))
         return out
+
+
+def local_extrema(freq_hz, magnitude):
+    """Frequencies of the local maxima and minima of a sampled magnitude (peaks and notches as
+    sampled, ends excluded): ``(maxima, minima)``."""
+    f, mag = np.asarray(freq_hz), np.asarray(magnitude)
+    i = np.arange(1, mag.size - 1)
+    mx = i[(mag[i] > mag[i - 1]) & (mag[i] >= mag[i + 1])]
+    mn = i[(mag[i] < mag[i - 1]) & (mag[i] <= mag[i + 1])]
+    return f[mx], f[mn]
 
 
 def sweep_frequencies(start: float = 20.0, stop: float = 225.0, step: float = 0.5) -> np.ndarray:

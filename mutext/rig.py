@@ -75,7 +75,7 @@ from .response import DIRECTIONS, FRF, INPUT_UNITS, OUTPUT_UNITS, sweep_frequenc
 
 __all__ = [
     "FRF", "FRFFileError", "Noise", "read_frf", "write_frf", "read_frfs", "measure",
-    "sweep_frequencies", "INPUT_UNITS", "OUTPUT_UNITS", "CSV_HEADER", "measure_rotor",
+    "sweep_frequencies", "INPUT_UNITS", "OUTPUT_UNITS", "CSV_HEADER", "measure_rotor", "with_noise",
     "THESIS_SWEEP_HZ", "THESIS_ANALYSIS_BAND_HZ", "THESIS_EXCITATION_A", "THESIS_SPEED_HZ",
 ]
 
@@ -630,10 +630,17 @@ def measure_rotor(model, input: str, output: str, freq_hz=None, *, noise=None, r
                      "breathing": ", ".join(f"{c.name} {c.law}" for c in pr.cracks),
                      "reduction_error": f"{red.reduction_error:.3g}"})
     ch = H.channel(output, input)
-    meas = measure(lambda w: ch.response, 0, 0, f, noise=noise, rng=rng,
-                   input_station=ch.input_station, output_station=ch.output_station,
-                   input_quantity=ch.input_quantity, output_quantity=ch.output_quantity,
-                   speed_hz=ch.speed_hz, metadata=meta, input_direction=ch.input_direction,
-                   output_direction=ch.output_direction)
-    meas.input_name, meas.output_name = input, output
-    return meas
+    ch.metadata = meta
+    return with_noise(ch, noise, rng=rng)
+
+
+def with_noise(frf: FRF, noise=None, *, rng=None) -> FRF:
+    """A copy of ``frf`` measured with ``noise`` (as in :func:`measure`: same generator, same
+    metadata entries); stations, quantities, directions, names and speed are kept."""
+    out = measure(lambda w: frf.response, 0, 0, frf.freq_hz, noise=noise, rng=rng,
+                  input_station=frf.input_station, output_station=frf.output_station,
+                  input_quantity=frf.input_quantity, output_quantity=frf.output_quantity,
+                  speed_hz=frf.speed_hz, metadata=frf.metadata, input_direction=frf.input_direction,
+                  output_direction=frf.output_direction)
+    out.input_name, out.output_name = frf.input_name, frf.output_name
+    return out

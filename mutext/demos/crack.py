@@ -22,7 +22,6 @@ cracked station table (density and disk mass) as the true system.
 """
 from __future__ import annotations
 
-import os
 import sys
 import time
 
@@ -64,10 +63,8 @@ def _identify(measured, E, out):
 
 def _k_peaks(K, f):
     from ..lti import freqresp
-    mag = np.abs(freqresp(K, 2 * np.pi * f)[0, 0])
-    i = np.arange(1, f.size - 1)
-    pk = i[(mag[i] > mag[i - 1]) & (mag[i] >= mag[i + 1])]
-    return [float(x) for x in f[pk]]
+    from ..response import local_extrema
+    return [float(x) for x in local_extrema(f, np.abs(freqresp(K, 2 * np.pi * f)[0, 0]))[0]]
 
 
 def solve(depth: float = 0.4, law: str = "mayes", noise: float = 0.001, seed: int = 0,
@@ -77,7 +74,7 @@ def solve(depth: float = 0.4, law: str = "mayes", noise: float = 0.001, seed: in
     from ..errors import ModelError
     from ..lti import freqresp
     from ..mbi import required_impedance
-    from ..rig import measure, measure_rotor
+    from ..rig import measure, measure_rotor, with_noise
     from ..rotor import modal_truncation
 
     if not (np.isfinite(noise) and 0 <= noise < 1):
@@ -92,12 +89,7 @@ def solve(depth: float = 0.4, law: str = "mayes", noise: float = 0.001, seed: in
     cracked = ex.cracked_rotor(depth, breathing=law)
     exact = measure_rotor(cracked, ex.EXCITATION, ex.MEASUREMENT)
     f = exact.freq_hz
-    measured = measure(lambda w: exact.response, 0, 0, f, noise=noise, rng=seed,
-                       input_station=exact.input_station, output_station=exact.output_station,
-                       input_quantity=exact.input_quantity, speed_hz=exact.speed_hz,
-                       metadata=exact.metadata, input_direction=exact.input_direction,
-                       output_direction=exact.output_direction)
-    measured.input_name, measured.output_name = ex.EXCITATION, ex.MEASUREMENT
+    measured = with_noise(exact, noise, rng=seed)
     say(f"rig: {law} crack, depth {depth:g} D at station {ex.CONTROL_OUTPUT[1:]}, {ex.SPEED_HZ:g} Hz; "
         f"{f.size} frequencies {f[0]:g}-{f[-1]:g} Hz, noise {noise:g} (Ritz reduction error "
         f"{exact.metadata.get('reduction_error')})")

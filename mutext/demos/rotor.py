@@ -31,17 +31,10 @@ def add_arguments(p):
     p.add_argument("--points", type=int, default=400, help="FRF frequencies in 20-225 Hz (default 400)")
 
 
-def _peaks(f, mag):
-    """Local maxima and minima of a sampled magnitude (Hz)."""
-    i = np.arange(1, mag.size - 1)
-    mx = i[(mag[i] > mag[i - 1]) & (mag[i] >= mag[i + 1])]
-    mn = i[(mag[i] < mag[i - 1]) & (mag[i] <= mag[i + 1])]
-    return f[mx], f[mn]
-
-
 def solve(model_path=None, *, n_modes=6, points=400, band=(20.0, 225.0)):
     """Everything the demo reports, as a dict (SI; frequencies in Hz)."""
     from ..errors import ModelError
+    from ..response import local_extrema
     from ..rotor import data_path, load_model
     for name, v, lo in (("--modes (n_modes)", n_modes, 1), ("--points (points)", points, 2)):
         if isinstance(v, (bool, np.bool_)) or not isinstance(v, (int, np.integer)) or v < lo:
@@ -67,7 +60,7 @@ def solve(model_path=None, *, n_modes=6, points=400, band=(20.0, 225.0)):
         out["whirl"][key] = md.whirl_direction()
         H = r.frf(f, inputs=["i12"], outputs=["x13"])("x13", "i12")
         out["frf"][key] = H
-        pk, an = _peaks(f, np.abs(H))
+        pk, an = local_extrema(f, np.abs(H))
         out["frf_peaks_hz"][key] = [float(x) for x in pk]
         out["frf_antiresonances_hz"][key] = [float(x) for x in an]
     r = rotors["healthy"]
@@ -118,6 +111,7 @@ def save_plots(out, directory):
     import matplotlib
     matplotlib.use("Agg", force=False)
     import matplotlib.pyplot as plt
+
     from ..errors import ModelError
     try:
         os.makedirs(directory, exist_ok=True)

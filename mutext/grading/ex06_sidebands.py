@@ -112,14 +112,14 @@ def sweep(name, noise, seed):
     """``(f, H)`` of the rig's sweep i12 -> x13 of a model with seeded noise, kept for the process.
 
     The same numbers as ``measure_rotor(model, "i12", "x13", noise=noise, rng=seed)``, which adds the
-    noise to the exact sweep with :func:`mutext.rig.measure`; the exact sweep (the costly harmonic
+    noise to the exact sweep with :func:`mutext.rig.with_noise`; the exact sweep (the costly harmonic
     balance) is computed once per model and shared by its noisy copies."""
-    from ..rig import measure, measure_rotor
+    from ..rig import measure_rotor, with_noise
     m = model(name)
     exact = _cached(("exact", name), lambda: measure_rotor(m, "i12", "x13"))
 
     def noisy():
-        d = measure(lambda w: exact.response, 0, 0, exact.freq_hz, noise=noise, rng=seed)
+        d = with_noise(exact, noise, rng=seed)
         return np.asarray(d.freq_hz, float).copy(), np.asarray(d.response, complex).copy()
     return _cached(("sweep", name, float(noise), int(seed)), noisy)
 

@@ -174,6 +174,27 @@ class PeriodicRotor:
     def time_invariant(self) -> bool:
         return not self.cracks or self.speed == 0.0
 
+    def ritz_basis(self, cutoff_hz: float) -> np.ndarray:
+        """The mass-orthonormal Ritz basis of :meth:`reduce` (``ndof x r``), without the error check."""
+        if self.basis is not None:
+            raise ModelError(f"{self.name}: the model is already reduced")
+        if not (isinstance(cutoff_hz, (int, float)) and np.isfinite(cutoff_hz) and cutoff_hz > 0):
+            raise ModelError(f"cutoff_hz must be a positive frequency [Hz], got {cutoff_hz!r}")
+        K0 = self.stiffness_harmonics(0)[0].real
+        with blas_single_thread():
+            lam, Phi = sla.eigh(K0, self.M)
+            keep = np.sqrt(np.maximum(lam, 0.0)) / (2 * np.pi) <= cutoff_hz
+            F = [self.B, self.Cy.T]
+            if self.cracks:
+                U, sv, _ = np.linalg.svd(np.hstack([a for c in self.cracks for a in c.A]))
+                F.append(U[:, :int(np.sum(sv > 1e-10 * sv[0]))])
+            V = np.hstack([Phi[:, keep], np.linalg.solve(K0, np.hstack(F))])
+            # drop directions already spanned, then re-diagonalise on the basis
+            R = np.linalg.qr(V, mode="r")
+            V = V[:, np.abs(np.diag(R)) > 1e-10 * np.max(np.abs(np.diag(R)))]
+            _, W = sla.eigh(V.T @ K0 @ V, V.T @ self.M @ V)
+        return V @ W
+
     def reduce(self, cutoff_hz: float, *, band_hz=(20.0, 225.0)) -> "PeriodicRotor":
         r"""Rayleigh-Ritz reduction: modes below ``cutoff_hz`` plus static shapes.
 
@@ -191,24 +212,7 @@ class PeriodicRotor:
         every 10th of those frequencies): the largest deviation over the
         largest response, over every channel.
         """
-        if self.basis is not None:
-            raise ModelError(f"{self.name}: the model is already reduced")
-        if not (isinstance(cutoff_hz, (int, float)) and np.isfinite(cutoff_hz) and cutoff_hz > 0):
-            raise ModelError(f"cutoff_hz must be a positive frequency [Hz], got {cutoff_hz!r}")
-        K0 = self.stiffness_harmonics(0)[0].real
-        with blas_single_thread():
-            lam, Phi = sla.eigh(K0, self.M)
-            keep = np.sqrt(np.maximum(lam, 0.0)) / (2 * np.pi) <= cutoff_hz
-            F = [self.B, self.Cy.T]
-            if self.cracks:
-                U, sv, _ = np.linalg.svd(np.hstack([a for c in self.cracks for a in c.A]))
-                F.append(U[:, :int(np.sum(sv > 1e-10 * sv[0]))])
-            V = np.hstack([Phi[:, keep], np.linalg.solve(K0, np.hstack(F))])
-            # drop directions already spanned, then re-diagonalise on the basis
-            Q, R = np.linalg.qr(V)
-            V = V[:, np.abs(np.diag(R)) > 1e-10 * np.max(np.abs(np.diag(R)))]
-            lr, W = sla.eigh(V.T @ K0 @ V, V.T @ self.M @ V)
-        red = self.project(V @ W)
+        red = self.project(self.ritz_basis(cutoff_hz))
         red.cutoff_hz = float(cutoff_hz)
         lo, hi = float(band_hz[0]), float(band_hz[1])
         if not (0 < lo < hi):
@@ -531,7 +535,7 @@ def stepped_sine(model, freqs_hz, *, input: str | None = None, output: str | Non
     oi = pr.outputs.index(output) if output is not None else 0
     if not (np.isfinite(amplitude) and amplitude > 0):
         raise ModelError(f"amplitude must be positive, got {amplitude!r}")
-    t_s, T = _settle(pr, settle_s, revolutions)
+    t_s, _ = _settle(pr, settle_s, revolutions)
     w_max = float(np.sqrt(np.max(np.linalg.eigvalsh(pr.stiffness_harmonics(0)[0].real))))
     if steps_per_rev is None:
         # RK4 is stable for h w < 2.8 on the imaginary axis: the stiffest Ritz shape sets the step;
