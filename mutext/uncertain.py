@@ -220,6 +220,17 @@ class UncertainModel:
             return rng.choice((-1.0, 1.0), size=(n, len(self.params)))
         return rng.uniform(-1.0, 1.0, size=(n, len(self.params)))
 
+    def corners(self) -> np.ndarray:
+        """Every vertex of the normalised parameter box, ``2**len(params)`` rows of +/-1.
+
+        Examples
+        --------
+        >>> from mutext.examples import two_mass_uncertain as tmu
+        >>> tmu.uncertain_model().corners().shape
+        (16, 4)
+        """
+        return np.array(list(itertools.product((-1.0, 1.0), repeat=len(self.params))))
+
 
 def uncertain_mck(matrices: Callable[[Mapping[str, float]], tuple], params: Sequence[UncertainParameter],
                   inputs: Mapping[str, object], outputs: Mapping[str, object], *,

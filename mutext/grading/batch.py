@@ -130,7 +130,8 @@ def _write_json(path: Path, data: dict):
     os.replace(tmp, path)
 
 
-def _grade_one(exercise: str, submission: str, time_limit: float, out_dir: str, directory: str) -> dict:
+def _grade_one(exercise: str, submission: str, time_limit: float, out_dir: str, directory: str,
+               require_isolation: bool = False) -> dict:
     """Grade one submission and write its results file; never raises (a failure is a row too)."""
     path = Path(submission)
     name = path.name
@@ -140,7 +141,7 @@ def _grade_one(exercise: str, submission: str, time_limit: float, out_dir: str, 
     try:
         if path.is_symlink() and not _inside(path, Path(directory)):
             raise GradingError(f"{name} is a symbolic link to a file outside the directory; not graded")
-        report = grade(exercise, path, time_limit=time_limit)
+        report = grade(exercise, path, time_limit=time_limit, require_isolation=require_isolation)
         data = report.to_gradescope()
         data["extra_data"]["submission"] = name
         row.update(score=report.score, max_score=report.max_score, isolation=report.isolation,
@@ -168,7 +169,7 @@ def _inside(path: Path, directory: Path) -> bool:
 
 
 def grade_batch(exercise: str, directory, *, jobs: int = 1, time_limit: float = 60.0, out_dir=None,
-                progress=None) -> BatchGrades:
+                progress=None, require_isolation: bool = False) -> BatchGrades:
     """Grade every submission in ``directory``; write a results file per submission and ``summary.csv``.
 
     Parameters
@@ -187,6 +188,9 @@ def grade_batch(exercise: str, directory, *, jobs: int = 1, time_limit: float = 
     out_dir : path, optional
         Where ``<name>.json`` and ``summary.csv`` go (default ``directory/results``).
     progress : callable(stage, fraction), optional
+    require_isolation : bool
+        Course mode: a submission whose run was not isolated scores 0 (as
+        :func:`mutext.grading.grade`).
 
     Returns
     -------
@@ -220,7 +224,8 @@ def grade_batch(exercise: str, directory, *, jobs: int = 1, time_limit: float = 
     except OSError as exc:
         raise GradingError(f"cannot create the results directory {out}: {exc.strerror or exc}") from None
     questions = [(q.id, q.points) for q in ex.questions()]
-    tasks = [(ex.name, str(p), float(time_limit), str(out), str(directory)) for p in subs]
+    tasks = [(ex.name, str(p), float(time_limit), str(out), str(directory), bool(require_isolation))
+             for p in subs]
     n = len(tasks)
     res = BatchGrades(ex.name, directory, out, questions, [], 1)
 

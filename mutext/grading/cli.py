@@ -11,6 +11,7 @@ from pathlib import Path
 from .core import EXERCISES, GradingError, grade
 
 USAGE_ERROR = 2
+NOT_ISOLATED = 3
 
 
 def _parser():
@@ -18,7 +19,8 @@ def _parser():
         prog="mutext grade",
         description="Grade a submission offline: per-question points and feedback. Given a directory, grade "
                     "every .py file in it: a results file per submission and a class summary CSV.",
-        epilog="Exit code 0 whenever grading completed (whatever the score), 2 on wrong usage; for a directory, "
+        epilog="Exit code 0 whenever grading completed (whatever the score), 2 on wrong usage, 3 with "
+               "--require-isolation when the run was not isolated; for a directory, "
                "1 if some submission could not be graded (named in the summary; the others are graded).")
     p.add_argument("exercise", nargs="?", help="exercise name (see --list); a unique prefix such as ex01 works")
     p.add_argument("submission", nargs="?", help="the student's .py file, or a directory of submissions "
@@ -30,6 +32,9 @@ def _parser():
                                                     "unless --json is given)")
     p.add_argument("--time-limit", type=float, default=60.0, metavar="SECONDS",
                    help="wall-clock limit for importing the submission and for each question (default 60)")
+    p.add_argument("--require-isolation", action="store_true",
+                   help="course mode: score 0 (exit code 3) unless the submission ran confined (isolation uid "
+                        "or landlock; see docs/grading.md)")
     b = p.add_argument_group("a directory of submissions")
     b.add_argument("--jobs", type=int, default=None, metavar="N",
                    help="submissions graded at once (default 1; -1: all cores); each still in its own confined "
@@ -66,7 +71,8 @@ def main(argv) -> int:
               "--output FILE", file=sys.stderr)
         return USAGE_ERROR
     try:
-        report = grade(args.exercise, args.submission, time_limit=args.time_limit)
+        report = grade(args.exercise, args.submission, time_limit=args.time_limit,
+                       require_isolation=args.require_isolation)
     except GradingError as exc:
         print(f"mutext grade: error: {exc}", file=sys.stderr)
         return USAGE_ERROR
@@ -81,7 +87,7 @@ def main(argv) -> int:
         print(json.dumps(results, indent=2))
     elif not args.json:
         print(report.text())
-    return 0
+    return NOT_ISOLATED if args.require_isolation and report.isolation not in ("uid", "landlock") else 0
 
 
 def _batch(args) -> int:
@@ -97,7 +103,7 @@ def _batch(args) -> int:
     jobs = 1 if args.jobs is None else args.jobs
     try:
         res = grade_batch(args.exercise, args.submission, jobs=jobs, time_limit=args.time_limit, out_dir=args.out,
-                          progress=ProgressLine(enabled=not args.quiet))
+                          progress=ProgressLine(enabled=not args.quiet), require_isolation=args.require_isolation)
     except GradingError as exc:
         print(f"mutext grade: error: {exc}", file=sys.stderr)
         return USAGE_ERROR

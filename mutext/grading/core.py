@@ -195,7 +195,7 @@ def _clip(x, hi):
     return round(min(max(float(x), 0.0), float(hi)), 2)
 
 
-def grade(exercise: str, submission, time_limit: float = 60.0) -> Report:
+def grade(exercise: str, submission, time_limit: float = 60.0, *, require_isolation: bool = False) -> Report:
     """Grade ``submission`` (a ``.py`` file) for ``exercise``.
 
     The submission runs in a confined child process (:mod:`mutext.grading.sandbox`)
@@ -227,7 +227,9 @@ def grade(exercise: str, submission, time_limit: float = 60.0) -> Report:
         With ``isolation``: ``"uid"`` (as root: the submission ran as an
         unprivileged user that cannot read the grader's files),
         ``"landlock"`` (a plain user on a kernel with Landlock) or ``"none"``
-        (not isolated; the report says so).
+        (not isolated; the report says so).  With ``require_isolation``, a
+        run that was not isolated scores 0 on every question (course mode: a
+        score that a submission could have forged is not given).
 
     Raises
     ------
@@ -299,5 +301,10 @@ def grade(exercise: str, submission, time_limit: float = 60.0) -> Report:
         reports.append(QuestionReport(q.id, q.name, _clip(score, q.points), q.points, fb))
     if warm is not None:
         warm.join()   # never leave a solver running in a thread at interpreter exit
+    if require_isolation and res.isolation not in ("uid", "landlock"):
+        why = ("not scored: this run was not isolated and isolation was required (--require-isolation), "
+               "so the submission could have reached the grader's files")
+        notes.insert(0, why)
+        reports = [QuestionReport(r.id, r.name, 0.0, r.max_score, [why], "not isolated") for r in reports]
     return Report(ex.name, ex.title, str(submission), reports, time.perf_counter() - t0, notes,
                   res.isolation, list(res.isolation_details))

@@ -501,6 +501,15 @@ def _rk4_propagators(pr: PeriodicRotor, P: int, h: float, input_index: int):
     return F, g
 
 
+def _port_index(names, name, kind: str) -> int:
+    """Position of port ``name`` among ``names`` (the first when ``None``), or a named error."""
+    if name is None:
+        return 0
+    if name not in names:
+        raise ModelError(f"no {kind} port '{name}' in this rotor; its {kind}s are {', '.join(names)}")
+    return list(names).index(name)
+
+
 def stepped_sine(model, freqs_hz, *, input: str | None = None, output: str | None = None,
                  amplitude: float = ANALYZER["amplitude"], revolutions: int = ANALYZER["revolutions"],
                  settle_s: float = ANALYZER["settle_s"], excitation_phase: float = 0.0,
@@ -528,11 +537,11 @@ def stepped_sine(model, freqs_hz, *, input: str | None = None, output: str | Non
     """
     t0 = time.perf_counter()
     pr = model if isinstance(model, PeriodicRotor) else periodic_rotor(model)
+    ii = _port_index(pr.inputs, input, "input")
+    oi = _port_index(pr.outputs, output, "output")
+    f = _freqs(freqs_hz)
     if pr.basis is None:
         pr = pr.reduce(cutoff_hz)
-    f = _freqs(freqs_hz)
-    ii = pr.inputs.index(input) if input is not None else 0
-    oi = pr.outputs.index(output) if output is not None else 0
     if not (np.isfinite(amplitude) and amplitude > 0):
         raise ModelError(f"amplitude must be positive, got {amplitude!r}")
     t_s, _ = _settle(pr, settle_s, revolutions)
