@@ -127,10 +127,10 @@ def test_a_submission_that_cannot_be_graded_is_recorded_and_the_rest_graded(tmp_
     shutil.copyfile(FILES["syntax_error.py"], tmp_path / "b_broken.py")
     real = gbatch.grade
 
-    def grade(exercise, path, time_limit=60.0):
+    def grade(exercise, path, time_limit=60.0, **kwargs):
         if Path(path).name == "b_broken.py":
             raise GradingError("the submission could not be run in a confined process: test")
-        return real(exercise, path, time_limit=time_limit)
+        return real(exercise, path, time_limit=time_limit, **kwargs)
     monkeypatch.setattr(gbatch, "grade", grade)
     res = gbatch.grade_batch("ex03_free_decay", tmp_path, jobs=1, out_dir=tmp_path / "out")
     assert [r["status"] for r in res.rows] == ["graded", "error"]
