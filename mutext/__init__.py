@@ -18,7 +18,8 @@ mbi
     Model-based identification: the unmodeled dynamics as a mu-controller.
 response
     One frequency-response type (a channel with its stations, directions,
-    port names and units) for measured and modelled data, and the sweep grid.
+    port names and units) for measured and modelled data, and the frequency
+    grids (``frequency_grid``).
 frfit
     Stable rational models of measured frequency responses (vector fitting).
 rig
@@ -35,6 +36,11 @@ rotor
 examples
     The thesis examples (two-mass, three-mass, rotor), shared by the book,
     demos, exercises and tests.
+
+The modules form layers, each importing only from its own and lower ones
+(checked by ``tests/test_layering.py``): errors, jsonio; lti, response;
+hinf, mu, frfit; dk, uncertain, rotor; mbi, rig, sysid, diagnose, hide, uff,
+batch, report; examples; demos, plots, grading, commands; cli.
 """
 
 from .errors import (IllPosedError, InfeasibleError, ModelError, MutextError,

@@ -56,6 +56,7 @@ from pathlib import Path
 import numpy as np
 
 from .errors import ModelError
+from .response import frequency_grid
 from .rig import Noise, measure, write_frf
 
 __all__ = ["hidden_effect_data", "HiddenCase", "EXAMPLES", "DETECTABLE", "plain_chain", "example_path"]
@@ -232,11 +233,8 @@ def _lumped_grid(M, K, C):
     import scipy.linalg as sla
     lam = sla.eigh(K, M, eigvals_only=True)
     f = np.sqrt(np.clip(lam, 0, None)) / (2 * np.pi)
-    f = f[f > 0]
-    lo, hi = 0.5 * f.min(), 1.4 * f.max()
-    step = float(f"{(hi - lo) / 400:.1g}")
-    lo = math.floor(lo / step) * step
-    return np.round(lo + step * np.arange(1, int((hi - lo) / step) + 1), 10)
+    # half the lowest to 1.4 times the highest natural frequency, in an analyser's round steps
+    return frequency_grid(n=400, poles=f, margin=(2.0, 1.4), spacing="step")
 
 
 def _case_lumped(path, seed, kind, noise, rng):

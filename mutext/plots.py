@@ -10,50 +10,30 @@ import os
 
 import numpy as np
 
+from . import response
+from ._mpl import db as _db, pyplot as _plt, save as _save
 from .lti import as_ss, freqresp, sigma_max
+from .report import diagnosis_figures
 
 __all__ = ["frequency_grid", "bode_mag", "bode_phase", "sigma_plot", "closed_loop_figure",
            "controller_figure", "sigma_figure", "two_mass_hinf_figures", "mbi_figure", "diagnosis_figures",
            "sideband_figure", "crack_identification_figure", "crack_figures"]
 
 
-def _plt():
-    # pyplot falls back to Agg by itself when no display is available
-    import matplotlib.pyplot as plt
-    return plt
-
-
 def frequency_grid(*systems, decades: float = 1.5, n: int = 800) -> np.ndarray:
     """Log-spaced grid (rad/s) covering the pole magnitudes of ``systems``.
 
-    The grid extends ``decades`` beyond the slowest and fastest nonzero pole
-    and contains the imaginary parts of lightly damped poles, so resonance
-    peaks are not missed (undamped poles: points 0.1 % either side).
+    :func:`mutext.response.frequency_grid` over their poles: the grid extends
+    ``decades`` beyond the slowest and fastest nonzero pole and contains the
+    imaginary parts of lightly damped poles, so resonance peaks are not missed
+    (undamped poles: points 0.1 % either side).
     """
-    mags, extra = [], []
-    for s in systems:
-        s = as_ss(s)
-        if s.nstates:
-            p = np.linalg.eigvals(np.asarray(s.A, float))
-            mags.extend(np.abs(p[np.abs(p) > 0]))
-            osc = p[np.abs(p.imag) > 0]
-            undamped = np.abs(osc.real) <= 1e-12 * np.abs(osc)
-            extra.extend(np.abs(osc.imag[~undamped]))
-            # an undamped mode has infinite gain at its frequency: sample either side
-            w0 = np.abs(osc.imag[undamped])
-            extra.extend(np.concatenate([w0 * (1 - 1e-3), w0 * (1 + 1e-3)]))
-    if not mags:
-        return np.logspace(-2, 2, n)
-    lo = np.log10(min(mags)) - decades
-    hi = np.log10(max(mags)) + decades
-    return np.unique(np.concatenate([np.logspace(lo, hi, n), extra]))
+    poles = [np.linalg.eigvals(np.asarray(s.A, float)) for s in map(as_ss, systems) if s.nstates]
+    return response.frequency_grid(n=n, poles=np.concatenate(poles) if poles else (),
+                                   margin=(10.0 ** decades, 10.0 ** decades), resonance_offsets=(0.0,))
 
 
-def _db(x):
-    return 20.0 * np.log10(np.maximum(np.abs(x), 1e-300))
-
-
-def bode_mag(ax, sys, omega, output: int = 0, input: int = 0, db: bool = True, **kw):
+def bode_mag(ax, sys, omega, out_index: int = 0, in_index: int = 0, db: bool = True, **kw):
     """Plot ``|G_ij(j w)|`` of one channel on ``ax`` (dB if ``db``, else absolute).
 
     Parameters
@@ -62,8 +42,8 @@ def bode_mag(ax, sys, omega, output: int = 0, input: int = 0, db: bool = True, *
     sys : control.StateSpace
     omega : array_like
         Frequencies in rad/s.
-    output, input : int
-        Channel indices.
+    out_index, in_index : int
+        Output and input of the channel.
     db : bool
         Plot ``20 log10 |G|`` (default) or ``|G|``.
     **kw
@@ -73,7 +53,7 @@ def bode_mag(ax, sys, omega, output: int = 0, input: int = 0, db: bool = True, *
     -------
     matplotlib.axes.Axes
     """
-    G = freqresp(sys, omega)[output, input]
+    G = freqresp(sys, omega)[out_index, in_index]
     ax.semilogx(omega, _db(G) if db else np.abs(G), **kw)
     ax.set_xlabel("frequency [rad/s]")
     ax.set_ylabel("magnitude [dB]" if db else "magnitude")
@@ -81,9 +61,9 @@ def bode_mag(ax, sys, omega, output: int = 0, input: int = 0, db: bool = True, *
     return ax
 
 
-def bode_phase(ax, sys, omega, output: int = 0, input: int = 0, **kw):
+def bode_phase(ax, sys, omega, out_index: int = 0, in_index: int = 0, **kw):
     """Plot the unwrapped phase (degrees) of one channel on ``ax``."""
-    G = freqresp(sys, omega)[output, input]
+    G = freqresp(sys, omega)[out_index, in_index]
     ax.semilogx(omega, np.degrees(np.unwrap(np.angle(G))), **kw)
     ax.set_xlabel("frequency [rad/s]")
     ax.set_ylabel("phase [deg]")
@@ -210,7 +190,7 @@ def sigma_figure(CL, omega=None, levels=None, title=None):
     return fig
 
 
-def two_mass_hinf_figures(res, P, outdir) -> list[str]:
+def two_mass_hinf_figures(res, P, outdir, thesis_gamma: float | None = None) -> list[str]:
     """Save the analogues of thesis Figures 2.6-2.8 for the two-mass H-infinity design.
 
     Parameters
@@ -221,6 +201,9 @@ def two_mass_hinf_figures(res, P, outdir) -> list[str]:
         The generalized plant (inputs ``f1, f2, u``; outputs ``z1, z2, y``).
     outdir : str or path
         Directory (created if missing).
+    thesis_gamma : float, optional
+        The thesis's gamma, drawn beside the optimal one in Fig. 2.8
+        (:data:`mutext.examples.two_mass.THESIS_GAMMA`); not drawn when None.
 
     Returns
     -------
@@ -229,12 +212,13 @@ def two_mass_hinf_figures(res, P, outdir) -> list[str]:
         controller frequency response (Fig. 2.7), largest singular value of
         the closed loop (Fig. 2.8).
     """
-    from .examples.two_mass import THESIS_GAMMA
-
     plt = _plt()
     os.makedirs(outdir, exist_ok=True)
     omega = np.logspace(-1, 3, 1200)
     omega = np.unique(np.concatenate([omega, frequency_grid(P, decades=0.5, n=2)]))
+    levels = {"optimal gamma (LMI)": res.gamma}
+    if thesis_gamma is not None:
+        levels["thesis gamma"] = thesis_gamma
     files = []
     figs = [
         ("two_mass_fig2_6_closed_loop.png",
@@ -245,8 +229,7 @@ def two_mass_hinf_figures(res, P, outdir) -> list[str]:
         ("two_mass_fig2_7_controller.png",
          controller_figure(res.K, omega, title=f"H-infinity controller ({res.controller_order} states)")),
         ("two_mass_fig2_8_sigma.png",
-         sigma_figure(res.CL, omega, levels={"optimal gamma (LMI)": res.gamma,
-                                             "thesis gamma": THESIS_GAMMA},
+         sigma_figure(res.CL, omega, levels=levels,
                       title="largest singular value of the closed loop")),
     ]
     for name, fig in figs:
@@ -326,82 +309,6 @@ def mbi_figure(result, true_systems, Du=None, title=None):
         fig.suptitle(title)
     fig.tight_layout()
     return fig
-
-
-def _save(fig, outdir, name) -> str:
-    """Save ``fig`` as ``outdir/name`` (PNG, tight layout), close it and return the path."""
-    fig.tight_layout()
-    path = os.path.join(outdir, name)
-    fig.savefig(path, dpi=110)
-    _plt().close(fig)
-    return path
-
-
-def diagnosis_figures(result, outdir) -> list[str]:
-    """Figures of a :class:`mutext.diagnose.Diagnosis` saved as PNG in ``outdir``; returns the paths.
-
-    ``overlay.png``: magnitude and phase of data, engineering model and extended
-    model for each channel; ``residual.png``: the model/data log-magnitude
-    ratio over frequency before and after; ``ranking.png``: the improvement
-    left after each of the best hypotheses, in units of the misfit noise alone leaves (the right
-    hypothesis brings it to about 1).
-    """
-    plt = _plt()
-    os.makedirs(outdir, exist_ok=True)
-    paths = []
-    chans = result.channels
-    n = len(chans)
-    ncol = min(n, 3)
-    nrow = -(-n // ncol)
-    fig, axes = plt.subplots(2 * nrow, ncol, figsize=(4.4 * ncol, 4.6 * nrow), squeeze=False, sharex="col")
-    for k in range(n, nrow * ncol):
-        axes[2 * (k // ncol), k % ncol].set_visible(False)
-        axes[2 * (k // ncol) + 1, k % ncol].set_visible(False)
-    for k, c in enumerate(chans):
-        ax, axp = axes[2 * (k // ncol), k % ncol], axes[2 * (k // ncol) + 1, k % ncol]
-        ax.semilogy(c.freq_hz, np.abs(c.measured), ".", ms=2.5, color="0.3", label="measured")
-        ax.semilogy(c.freq_hz, np.abs(c.before), "-", color="C3", lw=1.2, label="model")
-        axp.plot(c.freq_hz, np.degrees(np.angle(c.measured)), ".", ms=2.5, color="0.3")
-        axp.plot(c.freq_hz, np.degrees(np.angle(c.before)), "-", color="C3", lw=1.2)
-        if c.after is not None:
-            ax.semilogy(c.freq_hz, np.abs(c.after), "--", color="C0", lw=1.2, label="extended model")
-            axp.plot(c.freq_hz, np.degrees(np.angle(c.after)), "--", color="C0", lw=1.2)
-        ax.set_title(f"{c.label} ({c.role})", fontsize=9)
-        axp.set_xlabel("frequency [Hz]")
-        if k == 0:
-            ax.set_ylabel("|H| [SI]")
-            axp.set_ylabel("phase [deg]")
-            ax.legend(fontsize=7)
-    paths.append(_save(fig, outdir, "overlay.png"))
-
-    fig, ax = plt.subplots(figsize=(7, 3.6))
-    colors = plt.cm.tab20(np.linspace(0, 1, max(len(chans), 2)))
-    for k, c in enumerate(chans):
-        tag = f"{c.label} ({c.role})"
-        ax.plot(c.freq_hz, _db(c.before) - _db(c.measured), "-", color=colors[k], lw=1, label=f"{tag} before")
-        if c.after is not None:
-            ax.plot(c.freq_hz, _db(c.after) - _db(c.measured), ":", color=colors[k], lw=1, label=f"{tag} after")
-    noise_db = 20 * np.log10(1 + result.noise)
-    ax.axhspan(-2 * noise_db, 2 * noise_db, color="0.85", label="2 x noise")
-    ax.set_xlabel("frequency [Hz]")
-    ax.set_ylabel("model / measured [dB]")
-    ax.legend(fontsize=7, ncol=2)
-    paths.append(_save(fig, outdir, "residual.png"))
-
-    top = [f for f in result.findings if f.kind != "none"][:10]
-    fig, ax = plt.subplots(figsize=(7, 0.35 * len(top) + 1.4))
-    labels = [f"{f.kind} @ {f.station} ({f.element})" for f in top][::-1]
-    vals = [max(result.misfit_left(f), 1e-3) for f in top][::-1]
-    ax.barh(labels, vals, color=["C0" if f.significant else "0.6" for f in top][::-1])
-    ax.axvline(1.0, color="C3", lw=1, label="noise alone")
-    ax.set_xscale("log")
-    ax.set_xlabel("misfit left after the hypothesis / misfit of the noise alone")
-    ax.set_title(f"{result.n_hypotheses} hypotheses; before any: "
-                 f"{result.misfit_left(next(f for f in result.findings if f.kind == 'none')):.3g}", fontsize=9)
-    ax.tick_params(axis="y", labelsize=7)
-    ax.legend(fontsize=7)
-    paths.append(_save(fig, outdir, "ranking.png"))
-    return paths
 
 
 def sideband_figure(frf, evidence, reference=None, title=None):

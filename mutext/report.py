@@ -1,18 +1,20 @@
 """Written results of a diagnosis: ``diagnosis.json``, an HTML report with its figures, the extended model.
 
 :func:`write_diagnosis` is what ``mutext diagnose --out DIR`` calls; the
-figures come from :func:`mutext.plots.diagnosis_figures`.
+figures are drawn by :func:`diagnosis_figures` (also offered as :func:`mutext.plots.diagnosis_figures`).
 """
 from __future__ import annotations
 
 import html
 import os
 
+import numpy as np
+
+from ._mpl import db as _db, pyplot as _plt, save as _save
 from .diagnose import Diagnosis, write_model
 from .jsonio import to_json as _to_json
-from .plots import diagnosis_figures
 
-__all__ = ["write_diagnosis", "to_json"]
+__all__ = ["write_diagnosis", "to_json", "diagnosis_figures"]
 
 
 def to_json(result: Diagnosis) -> str:
@@ -38,6 +40,73 @@ def write_diagnosis(result: Diagnosis, out_dir) -> dict:
     with open(hpath, "w", encoding="utf-8") as fh:
         fh.write(_html(result, [os.path.basename(p) for p in figs]))
     paths["report"] = hpath
+    return paths
+
+
+def diagnosis_figures(result, outdir) -> list[str]:
+    """Figures of a :class:`mutext.diagnose.Diagnosis` saved as PNG in ``outdir``; returns the paths.
+
+    ``overlay.png``: magnitude and phase of data, engineering model and extended
+    model for each channel; ``residual.png``: the model/data log-magnitude
+    ratio over frequency before and after; ``ranking.png``: the improvement
+    left after each of the best hypotheses, in units of the misfit noise alone leaves (the right
+    hypothesis brings it to about 1).
+    """
+    plt = _plt()
+    os.makedirs(outdir, exist_ok=True)
+    paths = []
+    chans = result.channels
+    n = len(chans)
+    ncol = min(n, 3)
+    nrow = -(-n // ncol)
+    fig, axes = plt.subplots(2 * nrow, ncol, figsize=(4.4 * ncol, 4.6 * nrow), squeeze=False, sharex="col")
+    for k in range(n, nrow * ncol):
+        axes[2 * (k // ncol), k % ncol].set_visible(False)
+        axes[2 * (k // ncol) + 1, k % ncol].set_visible(False)
+    for k, c in enumerate(chans):
+        ax, axp = axes[2 * (k // ncol), k % ncol], axes[2 * (k // ncol) + 1, k % ncol]
+        ax.semilogy(c.freq_hz, np.abs(c.measured), ".", ms=2.5, color="0.3", label="measured")
+        ax.semilogy(c.freq_hz, np.abs(c.before), "-", color="C3", lw=1.2, label="model")
+        axp.plot(c.freq_hz, np.degrees(np.angle(c.measured)), ".", ms=2.5, color="0.3")
+        axp.plot(c.freq_hz, np.degrees(np.angle(c.before)), "-", color="C3", lw=1.2)
+        if c.after is not None:
+            ax.semilogy(c.freq_hz, np.abs(c.after), "--", color="C0", lw=1.2, label="extended model")
+            axp.plot(c.freq_hz, np.degrees(np.angle(c.after)), "--", color="C0", lw=1.2)
+        ax.set_title(f"{c.label} ({c.role})", fontsize=9)
+        axp.set_xlabel("frequency [Hz]")
+        if k == 0:
+            ax.set_ylabel("|H| [SI]")
+            axp.set_ylabel("phase [deg]")
+            ax.legend(fontsize=7)
+    paths.append(_save(fig, outdir, "overlay.png"))
+
+    fig, ax = plt.subplots(figsize=(7, 3.6))
+    colors = plt.cm.tab20(np.linspace(0, 1, max(len(chans), 2)))
+    for k, c in enumerate(chans):
+        tag = f"{c.label} ({c.role})"
+        ax.plot(c.freq_hz, _db(c.before) - _db(c.measured), "-", color=colors[k], lw=1, label=f"{tag} before")
+        if c.after is not None:
+            ax.plot(c.freq_hz, _db(c.after) - _db(c.measured), ":", color=colors[k], lw=1, label=f"{tag} after")
+    noise_db = 20 * np.log10(1 + result.noise)
+    ax.axhspan(-2 * noise_db, 2 * noise_db, color="0.85", label="2 x noise")
+    ax.set_xlabel("frequency [Hz]")
+    ax.set_ylabel("model / measured [dB]")
+    ax.legend(fontsize=7, ncol=2)
+    paths.append(_save(fig, outdir, "residual.png"))
+
+    top = [f for f in result.findings if f.kind != "none"][:10]
+    fig, ax = plt.subplots(figsize=(7, 0.35 * len(top) + 1.4))
+    labels = [f"{f.kind} @ {f.station} ({f.element})" for f in top][::-1]
+    vals = [max(result.misfit_left(f), 1e-3) for f in top][::-1]
+    ax.barh(labels, vals, color=["C0" if f.significant else "0.6" for f in top][::-1])
+    ax.axvline(1.0, color="C3", lw=1, label="noise alone")
+    ax.set_xscale("log")
+    ax.set_xlabel("misfit left after the hypothesis / misfit of the noise alone")
+    ax.set_title(f"{result.n_hypotheses} hypotheses; before any: "
+                 f"{result.misfit_left(next(f for f in result.findings if f.kind == 'none')):.3g}", fontsize=9)
+    ax.tick_params(axis="y", labelsize=7)
+    ax.legend(fontsize=7)
+    paths.append(_save(fig, outdir, "ranking.png"))
     return paths
 
 

@@ -1,4 +1,4 @@
-r"""Frequency responses: one type for measured and modelled channels, and the sweep grid.
+r"""Frequency responses: one type for measured and modelled channels, and the frequency grids.
 
 :class:`FRF` is one input-output channel in SI units with what identifies it
 in a model -- stations, directions, port names, quantities, running speed --
@@ -9,7 +9,9 @@ fitted (:func:`mutext.rotor.tuning.tune`), identified from
 (:func:`mutext.mbi.identify`) and diagnosed (:func:`mutext.diagnose.diagnose`)
 alike.  :class:`FRFMatrix` is a model's responses between named ports
 (:func:`mutext.rotor.analysis.frf`).  Frequencies are in Hz (``omega`` gives
-rad/s).
+rad/s).  :func:`frequency_grid` builds the frequency grids of the package
+(a band, densified at resonances or kept clear of them), :func:`sweep_frequencies`
+a sine sweep's; :class:`FRFFileError` is what a malformed FRF file raises.
 
 Examples
 --------
@@ -32,8 +34,8 @@ import numpy as np
 
 from .errors import ModelError
 
-__all__ = ["FRF", "FRFMatrix", "sweep_frequencies", "local_extrema", "INPUT_UNITS", "OUTPUT_UNITS",
-           "DIRECTIONS"]
+__all__ = ["FRF", "FRFFileError", "FRFMatrix", "sweep_frequencies", "frequency_grid", "local_extrema",
+           "INPUT_UNITS", "OUTPUT_UNITS", "DIRECTIONS"]
 
 #: Allowed input quantities and their unit (the SI unit; factor to SI is 1).
 INPUT_UNITS: dict[str, dict[str, float]] = {"force": {"N": 1.0}, "current": {"A": 1.0}}
@@ -45,6 +47,35 @@ OUTPUT_UNITS: dict[str, dict[str, float]] = {
 
 #: Directions of a force or a sensor in the plane of a rotor.
 DIRECTIONS = ("x", "y")
+
+
+class FRFFileError(ModelError):
+    """A malformed FRF file; the message names the file, the line and the field.
+
+    Attributes
+    ----------
+    path : str
+    line : int or None
+        1-based line number, or None for whole-file problems.
+    field : str or None
+        Header key or CSV column concerned (for a Universal File: the data set
+        58 field, e.g. ``ord_data_type``, ``rsp_dir``).
+    dataset : int or None
+        For a Universal File (:mod:`mutext.uff`): the 1-based position of the
+        data set in the file, or None for whole-file problems.
+    """
+
+    def __init__(self, path, line, field, problem, *, dataset=None):
+        self.path = str(path)
+        self.line = line
+        self.field = field
+        self.problem = problem
+        self.dataset = dataset
+        where = self.path if line is None else f"{self.path}, line {line}"
+        if dataset is not None:
+            where += f", data set {dataset}"
+        what = f" [{field}]" if field else ""
+        super().__init__(f"{where}{what}: {problem}")
 
 
 @dataclass
@@ -182,25 +213,25 @@ class FRFMatrix:
     speed: float
     ports: dict = field(default_factory=dict)
 
-    def __call__(self, output: str, input: str) -> np.ndarray:
-        """The response from ``input`` to ``output`` (complex, one per frequency)."""
+    def __call__(self, out_port: str, in_port: str) -> np.ndarray:
+        """The response from ``in_port`` to ``out_port`` (complex, one per frequency)."""
         try:
-            return self.H[self.outputs.index(output), self.inputs.index(input)]
+            return self.H[self.outputs.index(out_port), self.inputs.index(in_port)]
         except ValueError:
             raise ModelError(f"FRF has inputs {self.inputs} and outputs {self.outputs}; "
-                             f"asked for {input} -> {output}") from None
+                             f"asked for {in_port} -> {out_port}") from None
 
-    def channel(self, output: str, input: str) -> FRF:
+    def channel(self, out_port: str, in_port: str) -> FRF:
         """One channel as a :class:`FRF` (stations, directions, names, quantities and speed set)."""
-        H = self(output, input)
-        si, di, qi = self.ports.get(input, (None, "x", "force"))
-        so, do, qo = self.ports.get(output, (None, "x", "displacement"))
+        H = self(out_port, in_port)
+        si, di, qi = self.ports.get(in_port, (None, "x", "force"))
+        so, do, qo = self.ports.get(out_port, (None, "x", "displacement"))
         if qi not in INPUT_UNITS or qo not in OUTPUT_UNITS:
-            raise ModelError(f"channel {input} -> {output}: only force/current inputs and displacement "
+            raise ModelError(f"channel {in_port} -> {out_port}: only force/current inputs and displacement "
                              f"outputs make an FRF channel (got {qi} -> {qo})")
         return FRF(self.freqs_hz, H, input_station=si, output_station=so, input_quantity=qi,
                    output_quantity=qo, speed_hz=self.speed / (2 * math.pi) if self.speed else None,
-                   input_direction=di, output_direction=do, input_name=input, output_name=output)
+                   input_direction=di, output_direction=do, input_name=in_port, output_name=out_port)
 
     def channels(self) -> list:
         """Every force/current -> displacement channel as a :class:`FRF`, outputs first."""
@@ -243,3 +274,104 @@ def sweep_frequencies(start: float = 20.0, stop: float = 225.0, step: float = 0.
     n = int(math.floor((stop - start) / step + 1e-9)) + 1
     f = start + step * np.arange(n)
     return np.round(f, max(0, 11 - int(math.floor(math.log10(f[-1])))))
+
+
+def frequency_grid(band=None, n: int = 400, *, poles=(), margin=(10.0, 10.0), spacing: str = "log",
+                   resonance_offsets=None, avoid: float = 0.0) -> np.ndarray:
+    r"""Frequencies at which to evaluate a response: a grid over a band, densified at resonances
+    or kept clear of them.
+
+    The package's frequency grids are built here; the unit is the caller's
+    (rad/s or Hz), the same for ``band`` and ``poles``.
+
+    Parameters
+    ----------
+    band : (float, float), optional
+        ``(lo, hi)``.  Default: the magnitudes of the nonzero ``poles``,
+        ``margin[0]`` times below the smallest and ``margin[1]`` times above
+        the largest (``(1e-2, 1e2)`` when there is none).
+    n : int
+        Number of grid points (for ``spacing="step"``: about that many).
+    poles : array_like
+        Poles (complex) or natural frequencies (real, non-negative) of the
+        system to be sampled.
+    margin : (float, float)
+        Factors that widen the pole span into the default band (10, 10 = a
+        decade each side).
+    spacing : {"log", "linear", "step"}
+        ``"log"``: ``n`` log-spaced points (a band starting at 0 is sampled
+        from ``1e-6 hi`` and 0 is added); ``"linear"``: ``n`` equally spaced
+        points; ``"step"``: the multiples of a round step (one significant
+        digit of ``(hi - lo) / n``) above ``lo`` up to ``hi``, rounded to 10
+        decimals, as a sine-sweep analyser would step.
+    resonance_offsets : sequence of float, optional
+        Densify at resonances: each oscillating pole :math:`p` adds
+        :math:`|\Im p| + k |\Re p|` for each ``k`` (:math:`|\Re p|` is the
+        half-power half-width, so ``(-1, 0, 1)`` brackets the peak); an
+        undamped pole adds :math:`|\Im p|(1 \pm 10^{-3})` instead, its gain
+        being infinite at :math:`|\Im p|`.  Points outside the band are dropped.
+    avoid : float
+        Drop grid points within this relative distance of any nonzero
+        :math:`|p|` (comparing undamped models next to their poles would
+        compare rounding errors).
+
+    Returns
+    -------
+    ndarray
+        Sorted, without repeats.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from mutext.response import frequency_grid
+    >>> frequency_grid((1.0, 100.0), 3)
+    array([  1.,  10., 100.])
+    >>> p = np.array([-0.1 + 10j, -0.1 - 10j])          # a resonance at 10 rad/s, half-width 0.1
+    >>> w = frequency_grid(n=50, poles=p, resonance_offsets=(-1, 0, 1))
+    >>> round(float(w[0]), 3), round(float(w[-1]), 2), bool(np.isin([9.9, 10.0, 10.1], w).all())
+    (1.0, 100.0, True)
+    """
+    poles = np.atleast_1d(np.asarray(poles, complex))
+    lo, hi = _grid_band(band, poles, margin)
+    if spacing == "log":
+        w = np.logspace(np.log10(max(lo, 1e-6 * hi)), np.log10(hi), n)
+        if lo == 0.0:
+            w = np.concatenate([[0.0], w])
+    elif spacing == "linear":
+        w = np.linspace(lo, hi, n)
+    elif spacing == "step":
+        step = float(f"{(hi - lo) / n:.1g}")
+        lo = math.floor(lo / step) * step
+        w = np.round(lo + step * np.arange(1, int((hi - lo) / step) + 1), 10)
+    else:
+        raise ModelError(f"frequency_grid: spacing must be 'log', 'linear' or 'step', got {spacing!r}")
+    if avoid > 0:
+        for m in np.abs(poles[poles != 0]):
+            w = w[np.abs(w / m - 1.0) > avoid]
+    if resonance_offsets is not None:
+        extra = _resonance_points(poles, resonance_offsets)
+        w = np.concatenate([w, extra[(extra >= lo) & (extra <= hi)]])
+    return np.unique(w)
+
+
+def _grid_band(band, poles, margin):
+    if band is None:
+        mags = np.abs(poles[poles != 0])
+        if not mags.size:
+            return 1e-2, 1e2
+        return float(mags.min() / margin[0]), float(mags.max() * margin[1])
+    lo, hi = float(band[0]), float(band[1])
+    if not (math.isfinite(lo) and math.isfinite(hi) and 0 <= lo < hi):
+        raise ModelError(f"frequency_grid: band must be (lo, hi) with 0 <= lo < hi, got {band!r}")
+    return lo, hi
+
+
+def _resonance_points(poles, offsets):
+    """Points at the oscillating poles' frequencies (see :func:`frequency_grid`)."""
+    osc = poles[poles.imag != 0]
+    undamped = np.abs(osc.real) <= 1e-12 * np.abs(osc)
+    w0 = np.abs(osc.imag[undamped])
+    damped = osc[~undamped]
+    k = np.asarray(offsets, float)
+    return np.concatenate([(np.abs(damped.imag)[:, None] + np.abs(damped.real)[:, None] * k).ravel(),
+                           w0 * (1 - 1e-3), w0 * (1 + 1e-3)])

@@ -71,7 +71,8 @@ from typing import Mapping, Sequence
 import numpy as np
 
 from .errors import ModelError
-from .response import DIRECTIONS, FRF, INPUT_UNITS, OUTPUT_UNITS, sweep_frequencies
+from .response import DIRECTIONS, FRF, INPUT_UNITS, OUTPUT_UNITS, FRFFileError, sweep_frequencies
+from .uff import is_uff_file, read_uff58
 
 __all__ = [
     "FRF", "FRFFileError", "Noise", "read_frf", "write_frf", "read_frfs", "measure",
@@ -95,35 +96,6 @@ _REQUIRED = ("input_station", "input_quantity", "input_unit",
              "output_station", "output_quantity", "output_unit")
 _OPTIONAL = ("speed_hz", "input_direction", "output_direction", "input_name", "output_name")
 _RESERVED = _REQUIRED + _OPTIONAL
-
-
-class FRFFileError(ModelError):
-    """A malformed FRF file; the message names the file, the line and the field.
-
-    Attributes
-    ----------
-    path : str
-    line : int or None
-        1-based line number, or None for whole-file problems.
-    field : str or None
-        Header key or CSV column concerned (for a Universal File: the data set
-        58 field, e.g. ``ord_data_type``, ``rsp_dir``).
-    dataset : int or None
-        For a Universal File (:mod:`mutext.uff`): the 1-based position of the
-        data set in the file, or None for whole-file problems.
-    """
-
-    def __init__(self, path, line, field, problem, *, dataset=None):
-        self.path = str(path)
-        self.line = line
-        self.field = field
-        self.problem = problem
-        self.dataset = dataset
-        where = self.path if line is None else f"{self.path}, line {line}"
-        if dataset is not None:
-            where += f", data set {dataset}"
-        what = f" [{field}]" if field else ""
-        super().__init__(f"{where}{what}: {problem}")
 
 
 # ----------------------------------------------------------------------------
@@ -181,9 +153,23 @@ def read_frf(path, *, mapping=None) -> FRF:
         non-increasing frequency, and a file without data rows; for a
         Universal File, naming the data set and field (:mod:`mutext.uff`), and
         a file with more than one FRF.
+
+    Examples
+    --------
+    >>> import os, tempfile
+    >>> from mutext.rig import read_frf
+    >>> path = os.path.join(tempfile.mkdtemp(), "x13_i12.csv")
+    >>> with open(path, "w") as fh:
+    ...     _ = fh.write("# input_station: 12\\n# input_quantity: current\\n# input_unit: A\\n"
+    ...                  "# output_station: 13\\n# output_quantity: displacement\\n# output_unit: um\\n"
+    ...                  "freq_hz,re,im\\n20.0,12.5,-0.31\\n20.5,12.7,-0.33\\n")
+    >>> h = read_frf(path)
+    >>> h.freq_hz, h.unit                               # micrometres per ampere read as m/A
+    (array([20. , 20.5]), 'm/A')
+    >>> print(h.response.round(12))
+    [1.25e-05-3.1e-07j 1.27e-05-3.3e-07j]
     """
     path = Path(path)
-    from .uff import is_uff_file, read_uff58
     if is_uff_file(path):
         frfs = read_uff58(path, mapping=mapping)
         if len(frfs) != 1:
@@ -415,7 +401,6 @@ def read_frfs(paths_or_glob, *, mapping=None) -> list[FRF]:
         paths = list(paths_or_glob)
         if not paths:
             raise ModelError("read_frfs: empty list of paths")
-    from .uff import is_uff_file, read_uff58
     out: list[FRF] = []
     for p in paths:
         if is_uff_file(p):

@@ -178,14 +178,24 @@ def damper_coefficient(damped: DecayEstimate, m_c: float, m_w: float, c_m: float
     return float(2 * (m_c + m_w) * z * w - c_m)
 
 
-def identify_three_mass(rig=None, m_w: float = 2.0, noise: float = 0.0, rng=0,
-                        correct_damping: bool = False, fs: float = 1000.0, duration: float = 3.0):
+def identify_three_mass(rig, m_w: float = 2.0, noise: float = 0.0, rng=0,
+                        correct_damping: bool = False, fs: float = 1000.0, duration: float = 3.0,
+                        air_damper: float = 0.0):
     """Simulate the identification experiment of thesis sec. 3.3.2 on a rig and identify it.
 
     Each cart is decayed alone (others clamped: stiffness ``k1``, ``k1 + k2``,
     ``k2 + k3`` for carts 1-3) bare and with ``m_w`` added; cart 3 again with the
     air damper.  The rig's cart masses are its masses minus ``m_w`` (the thesis
     identified them with 2 kg on each cart).
+
+    Parameters
+    ----------
+    rig : mutext.examples.three_mass.ThreeMass
+        The rig to simulate (its fields ``m1..m3``, ``k1..k3``, ``c1..c3``
+        and ``with_``), e.g. ``TABLE_3_1``.
+    air_damper : float
+        The share of ``c3`` (N s/m) due to the air damper, identified by its
+        own decay (eq. 3.6); 0 when cart 3 has none.
 
     Returns
     -------
@@ -194,10 +204,10 @@ def identify_three_mass(rig=None, m_w: float = 2.0, noise: float = 0.0, rng=0,
     table : list of dict
         One row per parameter: ``name``, ``true``, ``identified``, ``rel_error``.
     """
-    from .examples.three_mass import TABLE_3_1
-    rig = TABLE_3_1 if rig is None else rig
+    c_air = float(air_damper)
+    if not 0.0 <= c_air < rig.c3:
+        raise ModelError(f"air_damper must lie in [0, c3 = {rig.c3:.6g}) N s/m, got {air_damper!r}")
     rng = np.random.default_rng(rng)
-    c_air = 8.8078 if rig.c3 > 8.8078 else 0.0
     carts = [(rig.m1 - m_w, rig.k1, rig.c1), (rig.m2 - m_w, rig.k1 + rig.k2, rig.c2),
              (rig.m3 - m_w, rig.k2 + rig.k3, rig.c3 - c_air)]
     est = []

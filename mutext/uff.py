@@ -94,7 +94,7 @@ from pathlib import Path
 import numpy as np
 
 from .errors import ModelError
-from .response import FRF
+from .response import FRF, FRFFileError
 
 __all__ = ["G0", "LBF", "is_uff_file", "read_uff58", "write_uff58"]
 
@@ -127,7 +127,6 @@ _DIR_NAMES = {0: "scalar", 3: "Z translation", 4: "X rotation", 5: "Y rotation",
 
 
 def _err(path, n, fld, problem):
-    from .rig import FRFFileError
     return FRFFileError(path, None, fld, problem, dataset=n)
 
 

@@ -269,15 +269,6 @@ def test_hide_rejects_bad_arguments():
         hidden_effect_data("three_mass", seed=-1)
 
 
-def test_docstring_examples_run():
-    import doctest
-    import mutext.diagnose
-    import mutext.hide
-    for mod in (mutext.diagnose, mutext.hide):
-        res = doctest.testmod(mod, optionflags=doctest.ELLIPSIS)
-        assert res.failed == 0 and res.attempted > 0
-
-
 def test_model_based_identification_reads_the_finding_the_same_way():
     """The thesis's route: a mu-controller at the found mass, read as mass/damper/spring, agrees."""
     case = hidden_effect_data("three_mass", seed=5, kind="stiffness", noise=0.01)

@@ -117,6 +117,18 @@ def test_references_are_the_simulated_parameters(questions):
         assert abs(wn / wd - 1) < ex03.RTOL_FREQ      # the undamped frequency passes too
 
 
+def test_solution_peaks_are_the_library_detector():
+    """The solution writes out :func:`mutext.sysid.decay_peaks` (a submission may not import it):
+    both find the same peaks on every record of the exercise, noisy ones included."""
+    from mutext.sysid import decay_peaks
+    records = [ex03.record(*r[1:4]) for r in ex03.A_RECORDS]
+    for _, m_c, k, c, m_w, noise, seed in ex03.D_CARTS:
+        records += [ex03.record(m_c, k, c, noise, seed), ex03.record(m_c + m_w, k, c, noise, seed + 100)]
+    for t, y in records:
+        for got, ref in zip(sol.peaks(t, y), decay_peaks(t, y)):
+            np.testing.assert_allclose(got, ref, rtol=1e-12, atol=0)
+
+
 @pytest.mark.parametrize("qid, answer, text", [
     ("a1", lambda t, y, N: 2 * math.pi / sol.natural_frequency(t, y, N), "this is the period"),
     ("a1", lambda t, y, N: sol.natural_frequency(t, y, N) / N, "spans N ="),

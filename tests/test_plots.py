@@ -22,7 +22,7 @@ def design():
 
 def test_two_mass_figures_saved(design, tmp_path):
     res, P = design
-    files = plots.two_mass_hinf_figures(res, P, tmp_path / "figs")
+    files = plots.two_mass_hinf_figures(res, P, tmp_path / "figs", thesis_gamma=two_mass.THESIS_GAMMA)
     assert len(files) == 3
     for f in files:
         assert os.path.isfile(f) and f.endswith(".png")
@@ -35,7 +35,7 @@ def test_small_functions_draw(design):
     w = plots.frequency_grid(P)
     assert np.all(np.diff(w) > 0) and w[0] < 7.46 < w[-1]
     fig, ax = plt.subplots()
-    plots.bode_mag(ax, P, w, output=0, input=0)
+    plots.bode_mag(ax, P, w, out_index=0, in_index=0)
     plots.bode_phase(ax, res.K, w)
     plots.sigma_plot(ax, res.CL, w)
     assert len(ax.lines) == 3

@@ -56,13 +56,6 @@ def test_measure_names_the_ports_of_a_state_space_model(rotor):
     np.testing.assert_allclose(h.response, rotor.frf([25.0, 35.0])("x13", "i12"), rtol=1e-8)
 
 
-def test_docstring_example_runs():
-    import doctest
-    import mutext.response
-    res = doctest.testmod(mutext.response)
-    assert res.failed == 0 and res.attempted > 0
-
-
 def test_sweep_grid_is_written_as_decimals(tmp_path):
     """A decimal sweep (0.2 Hz in 0.02 Hz steps) gives decimals in the file, not 0.30000000000000004."""
     from mutext.response import sweep_frequencies

@@ -19,6 +19,7 @@ from mutext.rotor import (BearingElement, DiskElement, ExciterElement, InputPort
                           loads_model, shaft_stiffness_with_compliance)
 from mutext.rotor.elements import (Layout, cowper_shear_coefficient, section_properties,
                                    timoshenko_plane_matrices, timoshenko_shape_functions)
+from mutext.rotor.analytic import beta_l, euler_bernoulli_frequency, timoshenko_pinned_frequency
 from mutext.rotor.units import rpm_to_rad_s
 
 STEEL = dict(E=2.1e11, rho=7800.0, nu=0.3)
@@ -84,26 +85,29 @@ def beam(n_el, L, d, planes=1, **kw):
     return Rotor([ShaftElement(i + 1, L / n_el, d, 0.0, **mat, **kw) for i in range(n_el)], planes=planes)
 
 
-def eb_omega(beta_L, L, d):
-    A, I = section_properties(d, 0.0)
-    return beta_L**2 * math.sqrt(STEEL["E"] * I / (STEEL["rho"] * A * L**4))
-
-
-FREE_FREE_BETA_L = [4.730040745, 7.853204624, 10.99560784]
+def eb_omega(mode, L, d, support="pinned"):
+    """Exact Euler-Bernoulli frequency [rad/s] of a steel beam of solid section ``d``."""
+    return euler_bernoulli_frequency(mode, L, STEEL["E"], STEEL["rho"], *section_properties(d, 0.0), support)
 
 
 def timoshenko_pinned_omega(n, L, d):
     """Exact pinned-pinned Timoshenko frequency (lower branch) of mode n."""
-    E, rho, nu = STEEL["E"], STEEL["rho"], STEEL["nu"]
-    G = E / (2 * (1 + nu))
-    kap = cowper_shear_coefficient(nu)
-    A, I = section_properties(d, 0.0)
-    k = n * math.pi / L
-    # det [[kGA k^2 - rho A w2, -kGA k], [-kGA k, EI k^2 + kGA - rho I w2]] = 0, quadratic in w2
-    a = rho * A * rho * I
-    b = -(rho * A * (E * I * k**2 + kap * G * A) + rho * I * kap * G * A * k**2)
-    c = kap * G * A * k**2 * (E * I * k**2 + kap * G * A) - (kap * G * A * k) ** 2
-    return math.sqrt((-b - math.sqrt(b * b - 4 * a * c)) / (2 * a))
+    E, nu = STEEL["E"], STEEL["nu"]
+    return timoshenko_pinned_frequency(n, L, E, E / (2 * (1 + nu)), STEEL["rho"], *section_properties(d, 0.0),
+                                       kappa=cowper_shear_coefficient(nu))
+
+
+def test_beam_references_against_published_values():
+    # beta L to the digits of Blevins' tables; the Timoshenko beam tends to Euler-Bernoulli when slender
+    np.testing.assert_allclose([beta_l("free", n) for n in (1, 2, 3)], [4.730040745, 7.853204624, 10.99560784],
+                               rtol=1e-9)
+    np.testing.assert_allclose([beta_l("cantilever", n) for n in (1, 2)], [1.875104069, 4.694091133], rtol=1e-9)
+    assert timoshenko_pinned_omega(1, 10.0, 0.01) == pytest.approx(eb_omega(1, 10.0, 0.01), rel=3e-6)
+    assert timoshenko_pinned_omega(1, 10.0, 0.01) < eb_omega(1, 10.0, 0.01)     # shear and rotary inertia lower it
+    with pytest.raises(ModelError, match="support"):
+        beta_l("clamped-clamped", 1)
+    with pytest.raises(ModelError, match="positive integer"):
+        beta_l("free", 0)
 
 
 def pinned(r):
@@ -115,7 +119,7 @@ def pinned(r):
 
 def test_free_free_euler_bernoulli_convergence():
     L, d = 1.0, 0.01                      # slender: L/d = 100
-    exact = np.array([eb_omega(b, L, d) for b in FREE_FREE_BETA_L])
+    exact = np.array([eb_omega(n, L, d, "free") for n in (1, 2, 3)])
     errs = []
     for n in (2, 4, 8, 16):
         w = 2 * np.pi * beam(n, L, d, shear=False, rotary_inertia=False).natural_frequencies()[:3]
@@ -145,13 +149,13 @@ def test_free_free_has_exactly_two_rigid_modes_per_plane(planes):
 def test_pinned_pinned_euler_bernoulli_and_thick_timoshenko_convergence():
     # slender, Euler-Bernoulli element: (n pi)^2
     L, d = 1.0, 0.01
-    ex_eb = np.array([eb_omega(n * math.pi, L, d) for n in (1, 2, 3)])
+    ex_eb = np.array([eb_omega(n, L, d) for n in (1, 2, 3)])
     err_eb = [np.abs(pinned(beam(n, L, d, shear=False, rotary_inertia=False))[:3] / ex_eb - 1) for n in (3, 6, 12)]
     assert np.all(np.diff(err_eb, axis=0) < 0) and err_eb[-1].max() < 5e-4 and err_eb[-1][0] < 1e-5
     # thick (L/d = 5), Timoshenko element: exact Timoshenko frequencies
     L, d = 1.0, 0.2
     ex_t = np.array([timoshenko_pinned_omega(n, L, d) for n in (1, 2, 3)])
-    ex_eb = np.array([eb_omega(n * math.pi, L, d) for n in (1, 2, 3)])
+    ex_eb = np.array([eb_omega(n, L, d) for n in (1, 2, 3)])
     assert np.all(ex_t[1:] < 0.95 * ex_eb[1:]) and ex_t[0] < 0.97 * ex_eb[0]   # shear matters here
     err_t = np.array([np.abs(pinned(beam(n, L, d))[:3] / ex_t - 1) for n in (4, 8, 16, 32)])
     assert np.all(np.diff(err_t, axis=0) < 0), err_t

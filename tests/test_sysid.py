@@ -4,6 +4,7 @@ import pytest
 
 from mutext.errors import ModelError
 from mutext.examples import three_mass
+from mutext.examples.three_mass import AIR_DAMPER, TABLE_3_1
 from mutext.lti import freqresp
 from mutext.sysid import (cart_parameters, decay_estimate, identify_three_mass,
                           simulate_free_decay)
@@ -30,13 +31,13 @@ def test_cart_mass_formula_gives_the_cart_not_the_weighted_cart():
 
 
 def test_identification_recovers_table_3_1_without_noise():
-    _, table = identify_three_mass(noise=0.0, correct_damping=True)
+    _, table = identify_three_mass(TABLE_3_1, air_damper=AIR_DAMPER, noise=0.0, correct_damping=True)
     for row in table:
         assert abs(row["rel_error"]) < 1e-4, row
 
 
 def test_thesis_formulas_are_close_but_biased():
-    _, table = identify_three_mass(noise=0.0, correct_damping=False)
+    _, table = identify_three_mass(TABLE_3_1, air_damper=AIR_DAMPER, noise=0.0, correct_damping=False)
     errs = {r["name"]: abs(r["rel_error"]) for r in table}
     assert max(errs.values()) < 0.02
     assert errs["c1"] > 1e-3        # the approximate decrement shows on the lightest cart
@@ -44,7 +45,7 @@ def test_thesis_formulas_are_close_but_biased():
 
 @pytest.mark.parametrize("seed", [0, 1, 2])
 def test_identification_with_encoder_noise(seed):
-    _, table = identify_three_mass(noise=2e-5, rng=seed, correct_damping=True)
+    _, table = identify_three_mass(TABLE_3_1, air_damper=AIR_DAMPER, noise=2e-5, rng=seed, correct_damping=True)
     for row in table:
         tol = 0.05 if row["name"].startswith("c") else 0.01
         assert abs(row["rel_error"]) < tol, row
@@ -88,3 +89,8 @@ def test_three_mass_trials_difference_sits_on_cart_3():
 def test_three_mass_rejects_bad_parameters():
     with pytest.raises(ModelError, match="m2 must be positive"):
         three_mass.matrices(three_mass.TABLE_3_1.with_(m2=0.0))
+
+
+def test_air_damper_outside_c3_is_refused():
+    with pytest.raises(ModelError, match="air_damper"):
+        identify_three_mass(TABLE_3_1, air_damper=TABLE_3_1.c3 + 1.0)

@@ -78,6 +78,6 @@ def run(args) -> int:
     if args.plots:
         from .. import plots
         os.makedirs(args.plots, exist_ok=True)
-        files = plots.two_mass_hinf_figures(res, out["plant"], args.plots)
+        files = plots.two_mass_hinf_figures(res, out["plant"], args.plots, thesis_gamma=two_mass.THESIS_GAMMA)
         print("plots saved: " + ", ".join(files), file=sys.stderr if args.json else sys.stdout)
     return 0

@@ -97,16 +97,7 @@ fifth frequency of each fitted channel, held out of the fit):
 and the gain :math:`e_{\mathrm{rel}}^{\mathrm{before}}/e_{\mathrm{rel}}^{\mathrm{after}}`.
 A well-diagnosed model reaches the noise level after the fix.
 
-Examples
---------
->>> from mutext.diagnose import diagnose
->>> from mutext.hide import hidden_effect_data
->>> case = hidden_effect_data("three_mass", seed=3, kind="stiffness", noise=0.01)
->>> d = diagnose(case.model, case.measured, validate=case.validate)
->>> d.findings[0].kind == case.key["kind"], d.findings[0].station == case.key["station"]
-(True, True)
->>> d.gain > 3
-True
+A worked example is in the Examples of :func:`diagnose`.
 
 References
 ----------

@@ -20,7 +20,8 @@ from ._compare import _errors, _model_modes, _resonance_table, _summary
 from ._extend import _refit, extended_model_text, mbi_reading, write_model
 from ._hypotheses import Hypothesis, _gain_hypotheses, hypotheses
 from ._result import ChannelComparison, Diagnosis, Finding
-from ._screen import _Data, _Evaluator, _Receptance, _fit_size, _jacobian_std, _resolve, _rss, _separating_station, _src
+from ._channels import _resolve, _src
+from ._screen import _Data, _Evaluator, _Receptance, _fit_size, _jacobian_std, _rss, _separating_station
 
 log = logging.getLogger("mutext.diagnose")
 
@@ -89,6 +90,21 @@ def diagnose(model, frfs, validate=None, *, alpha: float = 0.01, refit: int = 3,
     Returns
     -------
     Diagnosis
+
+    Examples
+    --------
+    The three-mass rig with a hidden stiffness change, its sweeps noisy at 1 %:
+    the diagnosis names the kind and the mass, and the extended model fits the
+    held-out data better.
+
+    >>> from mutext.diagnose import diagnose
+    >>> from mutext.hide import hidden_effect_data
+    >>> case = hidden_effect_data("three_mass", seed=3, kind="stiffness", noise=0.01)
+    >>> d = diagnose(case.model, case.measured, validate=case.validate)
+    >>> d.findings[0].kind == case.key["kind"], d.findings[0].station == case.key["station"]
+    (True, True)
+    >>> bool(d.gain > 3)
+    True
     """
     t0 = time.perf_counter()
 

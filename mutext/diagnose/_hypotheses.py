@@ -12,6 +12,7 @@ import numpy as np
 from ..rotor.crack import Crack
 from ..rotor.elements import BearingElement, Damper, ParameterSet, PointMass, Spring
 from ..rotor.model import load_model
+from ._channels import _resolve
 
 log = logging.getLogger("mutext.diagnose")
 
@@ -186,7 +187,6 @@ def hypotheses(model, frfs=None, *, stations=None) -> list[Hypothesis]:
     if kind != "lumped":
         hyps += _crack_hypotheses(model, stations)
     if frfs is not None:
-        from ._screen import _resolve      # the screen module builds on this one
         chans, _ = _resolve(model, list(frfs), "FRF")
         hyps += _gain_hypotheses(model, chans)
     return hyps

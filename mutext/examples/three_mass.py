@@ -16,10 +16,15 @@ force that depends on ``x3`` only, which is why the thesis places the
 identifying controller there.
 
 Excitation and measurement are at cart 1.  SI units throughout (kg, N/m, N s/m).
+The identified values are read from ``mutext/data/three_mass.toml``, the one
+copy of Table 3.1 (the model file that ``mutext diagnose`` and the rotor tools
+load too).
 """
 from __future__ import annotations
 
-from dataclasses import dataclass, replace
+import tomllib
+from dataclasses import dataclass, fields, replace
+from importlib import resources
 
 import control as ct
 import numpy as np
@@ -27,29 +32,51 @@ import numpy as np
 from ..errors import ModelError
 from ..lti import mck_to_ss
 
-__all__ = ["ThreeMass", "TABLE_3_1", "mechanical_model", "matrices", "Trial", "TRIALS"]
+__all__ = ["ThreeMass", "TABLE_3_1", "AIR_DAMPER", "mechanical_model", "matrices", "Trial", "TRIALS"]
 
 
 @dataclass(frozen=True)
 class ThreeMass:
-    """Parameters of the three-mass rig (SI units)."""
-    m1: float = 2.8113   # kg, cart 1 (0.8113) + 2.0 kg
-    m2: float = 2.6396   # kg
-    m3: float = 2.6074   # kg
-    k1: float = 842.3    # N/m, cart 1 to cart 2
-    k2: float = 806.5    # N/m, cart 2 to cart 3
-    k3: float = 386.0    # N/m, cart 3 to ground
-    c1: float = 5.2992   # N s/m, cart 1 bearings
-    c2: float = 1.9467   # N s/m
-    c3: float = 10.7375  # N s/m, cart 3 (1.9297) + air damper (8.8078)
+    """Parameters of the three-mass rig (SI units).
+
+    Attributes
+    ----------
+    m1, m2, m3 : float
+        Cart masses [kg] (Table 3.1: each with 2 kg added).
+    k1, k2, k3 : float
+        Springs [N/m]: cart 1 to cart 2, cart 2 to cart 3, cart 3 to ground.
+    c1, c2, c3 : float
+        Dampers from each cart to ground [N s/m] (``c3`` includes the air damper).
+    """
+    m1: float
+    m2: float
+    m3: float
+    k1: float
+    k2: float
+    k3: float
+    c1: float
+    c2: float
+    c3: float
 
     def with_(self, **kw) -> "ThreeMass":
         """A copy with some fields changed."""
         return replace(self, **kw)
 
 
-#: Identified parameters of thesis Table 3.1.
-TABLE_3_1 = ThreeMass()
+def _from_model_file(name: str = "three_mass.toml") -> ThreeMass:
+    """The rig of a shipped model file: its masses, springs and dampers by name."""
+    with resources.files("mutext").joinpath("data", name).open("rb") as fh:
+        doc = tomllib.load(fh)
+    values = {e["name"]: e[key] for section, key in (("mass", "mass"), ("spring", "stiffness"),
+                                                      ("damper", "damping")) for e in doc[section]}
+    return ThreeMass(**{f.name: float(values[f.name]) for f in fields(ThreeMass)})
+
+
+#: Identified parameters of thesis Table 3.1 (from ``mutext/data/three_mass.toml``).
+TABLE_3_1 = _from_model_file()
+
+#: The air damper's share of ``c3`` (N s/m), identified by its own decay (thesis eq. 3.6).
+AIR_DAMPER = 8.8078
 
 
 def matrices(p: ThreeMass = TABLE_3_1):

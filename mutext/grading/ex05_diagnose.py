@@ -28,6 +28,7 @@ import math
 
 import numpy as np
 
+from ..response import frequency_grid
 from .compare import as_array, fmt, returned
 from .core import Call, Exercise, Question
 
@@ -65,7 +66,7 @@ def grid(example):
     import scipy.linalg as sla
     M, C, K, _, _ = chain(example)
     f = np.sqrt(sla.eigh(K, M, eigvals_only=True)) / (2 * np.pi)
-    return np.round(np.linspace(0.5 * f.min(), 1.4 * f.max(), 400), 8)
+    return np.round(frequency_grid(n=400, poles=f, margin=(2.0, 1.4), spacing="linear"), 8)
 
 
 def response(M, C, K, f_hz, i_in, i_out, change=None):

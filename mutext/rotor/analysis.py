@@ -309,8 +309,20 @@ def frf(model, freqs_hz, *, inputs: Sequence[str] | None = None, outputs: Sequen
         speed: float | None = None, values=None) -> FRF:
     """Frequency responses between named ports at ``freqs_hz`` [Hz].
 
-    Default ports: all inputs and outputs of the model.  Returns an :class:`FRF`
-    with ``H`` of shape ``(noutputs, ninputs, nfreq)`` in output units per input unit.
+    Default ports: all inputs and outputs of the model.  Returns an
+    :class:`mutext.response.FRFMatrix` with ``H`` of shape
+    ``(noutputs, ninputs, nfreq)`` in output units per input unit.
+
+    Examples
+    --------
+    >>> from mutext.rotor import data_path, load_model
+    >>> from mutext.rotor.analysis import frf
+    >>> H = frf(load_model(data_path("three_mass.toml")), [1.0, 2.0], inputs=["f1"], outputs=["x1"])
+    >>> H.H.shape
+    (1, 1, 2)
+    >>> x = H.channel("x1", "f1")                       # one channel, as a measured FRF would be
+    >>> x.label, x.unit, round(float(abs(x.response[0])), 5)
+    ('f1->x1', 'm/N', 0.01369)
     """
     speed = _speed(model, speed)
     ins, outs = _ports(model, inputs, outputs)

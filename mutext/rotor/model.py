@@ -588,6 +588,17 @@ def load_model(path: str | os.PathLike, *, station_table: str | os.PathLike | No
     station_table : path-like, optional
         Use this station table instead of the one the file names (e.g. the
         cracked rotor's table with the healthy rotor's bearings and exciter).
+
+    Examples
+    --------
+    The three-mass rig shipped with the package (a lumped chain):
+
+    >>> from mutext.rotor import data_path, load_model
+    >>> rig = load_model(data_path("three_mass.toml"))
+    >>> rig.dof_names, rig.input_names, rig.output_names
+    (['m1', 'm2', 'm3'], ['f1', 'f3'], ['x1', 'x3'])
+    >>> rig.natural_frequencies().round(3)              # Hz
+    array([0.952, 3.12 , 4.919])
     """
     path = os.fspath(path)
     try:

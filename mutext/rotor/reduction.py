@@ -118,6 +118,7 @@ import scipy.linalg as sla
 
 from ..errors import IllPosedError, ModelError
 from ..lti import as_ss, balance_states, freqresp, hinf_norm, ss
+from ..response import frequency_grid
 
 __all__ = ["Reduction", "modal_truncation", "balanced_truncation", "hankel_singular_values",
            "reduction_error"]
@@ -218,19 +219,13 @@ def _default_band(sys: ct.StateSpace, hi_hz: float | None = None) -> tuple[float
 
 
 def _band_grid(band_hz, systems, n: int = 400) -> np.ndarray:
-    """Log-spaced grid on the band plus every pole frequency of ``systems`` inside it [Hz]."""
+    """Log-spaced grid on the band plus every pole frequency of ``systems`` inside it [Hz]
+    (an undamped pole: 0.1 % either side, see :func:`mutext.response.frequency_grid`)."""
     lo, hi = float(band_hz[0]), float(band_hz[1])
     if not (np.isfinite(lo) and np.isfinite(hi) and 0 <= lo < hi):
         raise ModelError(f"band_hz must be (lo, hi) with 0 <= lo < hi [Hz], got {band_hz!r}")
-    f = np.geomspace(max(lo, 1e-6 * hi), hi, n)
-    if lo == 0.0:
-        f = np.concatenate([[0.0], f])
-    extra = []
-    for s in systems:
-        if s.nstates:
-            w = np.abs(np.linalg.eigvals(np.asarray(s.A, float)).imag) / (2 * np.pi)
-            extra.append(w[(w >= lo) & (w <= hi)])
-    return np.unique(np.concatenate([f] + extra))
+    poles = [np.linalg.eigvals(np.asarray(s.A, float)) / (2 * np.pi) for s in systems if s.nstates]
+    return frequency_grid((lo, hi), n, poles=np.concatenate(poles) if poles else (), resonance_offsets=(0.0,))
 
 
 def reduction_error(full, reduced, band_hz=None, *, freqs_hz=None, hinf: bool = True,

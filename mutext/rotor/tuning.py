@@ -142,6 +142,7 @@ import numpy as np
 import scipy.linalg as sla
 
 from ..errors import ModelError, SolverError
+from ..response import FRF
 from .assembly import ModalDamping
 
 __all__ = ["TuneResult", "FRFSensitivity", "tune", "frf_sensitivity", "model_response",
@@ -236,8 +237,7 @@ def _direction(model, frf, which, k):
 
 
 def _resolve_channel(model, frf, k, inputs: _Inputs):
-    from ..rig import FRF as RigFRF
-    if not isinstance(frf, RigFRF):
+    if not isinstance(frf, FRF):
         raise ModelError(f"FRF #{k}: expected a mutext.rig.FRF, got {type(frf).__name__}")
     s_in, s_out = _station(model, frf, "input", k), _station(model, frf, "output", k)
     d_in, d_out = _direction(model, frf, "input", k), _direction(model, frf, "output", k)
@@ -452,13 +452,13 @@ class FRFSensitivity:
         with np.errstate(divide="ignore", invalid="ignore"):
             return self.values[:, None, None, None] * self.dH / self.H[None]
 
-    def __call__(self, output: str, input: str, parameter: str | None = None) -> np.ndarray:
+    def __call__(self, out_port: str, in_port: str, parameter: str | None = None) -> np.ndarray:
         """One channel: ``H`` (``parameter=None``) or ``dH/dp`` for the named parameter."""
         try:
-            o, i = self.outputs.index(output), self.inputs.index(input)
+            o, i = self.outputs.index(out_port), self.inputs.index(in_port)
         except ValueError:
             raise ModelError(f"sensitivity has inputs {self.inputs} and outputs {self.outputs}; asked "
-                             f"for {input} -> {output}") from None
+                             f"for {in_port} -> {out_port}") from None
         if parameter is None:
             return self.H[o, i]
         if parameter not in self.parameters:
@@ -747,11 +747,10 @@ def tune(model, frfs, parameters, bounds: Mapping | None = None, *, start: Mappi
     SolverError
         If IPOPT does not converge (the message gives IPOPT's return status).
     """
-    from ..rig import FRF as RigFRF
     from .analysis import blas_single_thread
     t_build = time.perf_counter()
     model = _as_model(model)
-    if isinstance(frfs, RigFRF):
+    if isinstance(frfs, FRF):
         frfs = [frfs]
     frfs = list(frfs)
     if not frfs:

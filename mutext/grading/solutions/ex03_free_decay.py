@@ -17,12 +17,16 @@ def peaks(t, y):
     The period comes from the spectrum's peak; each peak is refined by a
     least-squares parabola over a twentieth of a period (which averages the
     noise), and peaks lower than five times the noise level are dropped.
+    These are the steps of the library's :func:`mutext.sysid.decay_peaks`,
+    written out because a submission may not import it (this file runs as one);
+    ``tests/test_grading_ex03.py`` checks that the two find the same peaks.
     """
     t, y = np.asarray(t, float), np.asarray(y, float)
     dt = float(np.median(np.diff(t)))
     noise = float(np.std(np.diff(y, 2)) / np.sqrt(6.0))
     nfft = 1 << int(np.ceil(np.log2(8 * y.size)))
-    spec = np.abs(np.fft.rfft((y - np.mean(y)) * np.hanning(y.size), nfft))
+    tail = y[-max(5, y.size // 10):]          # the rest position: the mean of the last tenth
+    spec = np.abs(np.fft.rfft((y - np.mean(tail)) * np.hanning(y.size), nfft))
     freqs = np.fft.rfftfreq(nfft, dt)
     spec[freqs < 1.5 / (t[-1] - t[0])] = 0.0
     per = max(3, int(round(1.0 / (freqs[int(np.argmax(spec))] * dt))))
