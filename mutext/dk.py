@@ -52,7 +52,8 @@ with the optimal, unfitted scalings on a fine grid whose peaks are refined
 (every value is :math:`\bar\sigma(DMD^{-1})` for an explicit :math:`D`, a
 certified bound at that frequency), with lower bounds at the peaks
 (:func:`mutext.mu.mu_sweep`) and, when the structure has real blocks, the
-D-G bound (:func:`mutext.mu.mu_upper`).
+D-G bound at the frequencies that decide its peak
+(:func:`mutext.mu.mu_upper`, ``method="fast"``).
 
 Performance weights that approximate an integrator by a pole very close to the
 axis (e.g. at -1e-6 rad/s) combined with dynamic scalings of modes at tens of
@@ -80,6 +81,7 @@ import control as ct
 import numpy as np
 
 from .errors import IllPosedError, InfeasibleError, ModelError, SolverError
+from .frfit import MagnitudeFit, _constant, fit_magnitude
 from .hinf import hinfsyn, slycot_hinfsyn
 from .lti import as_ss, blas_single_thread, freqresp, lft_lower, ss
 from .mu import BlockStructure, MuSweep, default_grid, mu_sweep, mu_upper
@@ -93,313 +95,18 @@ __all__ = ["DScaleFit", "fit_dscale", "fit_dscale_auto", "scaled_plant", "DKResu
 # D-scale fitting
 # ----------------------------------------------------------------------------
 
-@dataclass
-class DScaleFit:
-    """A fitted scaling :math:`\\hat D(s)` (SISO, stable, minimum phase, biproper).
-
-    Attributes
-    ----------
-    sys : control.StateSpace
-        Realisation of :math:`\\hat D(s)`.
-    order : int
-        Number of poles (can be below the order asked of :func:`fit_dscale`
-        when roots at the edges of the data cancel).
-    error : float
-        Largest weighted error of :math:`\\log|\\hat D(j\\omega)|` against the data.
-    zeros, poles : ndarray
-        All in the open left half plane.
-    gain : float
-        :math:`\\hat D(\\infty)`.
-    """
-    sys: ct.StateSpace
-    order: int
-    error: float
-    zeros: np.ndarray
-    poles: np.ndarray
-    gain: float
-
-    def __call__(self, omega) -> np.ndarray:
-        """:math:`\\hat D(j\\omega)` at the frequencies ``omega`` (rad/s)."""
-        s = 1j * np.asarray(omega, dtype=float)
-        out = np.full(s.shape, self.gain, dtype=complex)
-        for z in self.zeros:
-            out = out * (s - z)
-        for p in self.poles:
-            out = out / (s - p)
-        return out
-
-    def inverse(self) -> ct.StateSpace:
-        """Realisation of :math:`\\hat D(s)^{-1}` (stable: the zeros of :math:`\\hat D` are)."""
-        return _zpk_ss(self.poles, self.zeros, 1.0 / self.gain)
-
-
-def _constant(g: float) -> ct.StateSpace:
-    return ss(np.zeros((0, 0)), np.zeros((0, 1)), np.zeros((1, 0)), [[g]])
-
-
-def _sections(roots):
-    """Split roots into real monic first- and second-order polynomials."""
-    roots = list(np.asarray(roots, complex))
-    lin, quad = [], []
-    while roots:
-        a = roots.pop(0)
-        if abs(a.imag) > 1e-12 * max(1.0, abs(a)):
-            if not roots:
-                raise ModelError("a complex D-scale root has no conjugate partner")
-            k = int(np.argmin([abs(b - a.conjugate()) for b in roots]))
-            b = roots.pop(k)
-            quad.append(np.real(np.poly([a, b])))
-        else:
-            lin.append(np.array([1.0, -a.real]))
-    return lin, quad
-
-
-def _zpk_ss(zeros, poles, gain) -> ct.StateSpace:
-    """Real realisation of ``gain * prod(s - z) / prod(s - p)`` (biproper) as a cascade
-    of first- and second-order sections, which stays well conditioned when the
-    roots spread over decades."""
-    if len(zeros) != len(poles):
-        raise ModelError("D-scale numerator and denominator degrees differ")
-    lz, qz = _sections(zeros)
-    lp, qp = _sections(poles)
-    pairs = []
-    try:
-        for den in qp:
-            pairs.append((qz.pop(0) if qz else np.polymul(lz.pop(0), lz.pop(0)), den))
-        for num in qz:
-            pairs.append((num, np.polymul(lp.pop(0), lp.pop(0))))
-        pairs += list(zip(lz, lp))
-    except IndexError:
-        raise ModelError("cannot pair the zeros and poles of a D-scale") from None
-    sys = _constant(gain)
-    for num, den in pairs:
-        sys = ct.series(sys, ct.ss(ct.tf(num, den)))
-    return ss(sys.A, sys.B, sys.C, sys.D)
-
-
-def _log_fit_error(fit: DScaleFit, omega, mag, weight):
-    return float(np.max(weight * np.abs(np.log(np.abs(fit(omega))) - np.log(mag))))
-
-
-def _pf_basis(x, poles) -> np.ndarray:
-    """Real partial-fraction basis on real ``x``: ``1/(x - a)`` for a real pole ``a``;
-    ``2 Re q`` and ``-2 Im q`` with ``q = 1/(x - a)`` for a complex pair (``a`` with Im > 0)."""
-    cols = []
-    for a in poles:
-        q = 1.0 / (x - a)
-        cols += [q.real] if a.imag == 0 else [2.0 * q.real, -2.0 * q.imag]
-    return np.column_stack(cols)
-
-
-def _pf_state(poles):
-    """``(A, b)`` with ``(xI - A)^-1 b`` equal to the basis of :func:`_pf_basis`."""
-    n = sum(1 if a.imag == 0 else 2 for a in poles)
-    A, b = np.zeros((n, n)), np.zeros(n)
-    i = 0
-    for a in poles:
-        if a.imag == 0:
-            A[i, i], b[i] = a.real, 1.0
-            i += 1
-        else:
-            A[i:i + 2, i:i + 2] = [[a.real, a.imag], [-a.imag, a.real]]
-            b[i] = 2.0
-            i += 2
-    return A, b
-
-
-def _admissible(lam, xmin, xmax, zeta_min: float = 0.1):
-    """Relocated poles of Phi(x) made admissible: one entry per real pole or conjugate
-    pair (Im > 0), off the positive real axis (that would be a pole of D on the
-    imaginary axis; damping ratio at least ``zeta_min``) and within two decades of
-    the data in magnitude."""
-    out = []
-    th_min = 2.0 * np.arcsin(zeta_min)       # arg of x for damping ratio zeta: 2 asin(zeta)
-    for v in lam:
-        if v.imag < -1e-12 * abs(v):
-            continue                           # the partner of a pair already taken
-        r = float(np.clip(abs(v), xmin * 1e-2, xmax * 1e2))
-        th = float(np.angle(v)) if abs(v.imag) > 1e-12 * abs(v) else (np.pi if v.real <= 0 else 0.0)
-        if th < th_min:
-            th = np.pi if abs(v.imag) <= 1e-12 * abs(v) else th_min
-        out.append(complex(-r) if th >= np.pi - 1e-12 else r * np.exp(1j * th))
-    # separate coincident real poles (keeps the basis independent)
-    real = sorted(-a.real for a in out if a.imag == 0)
-    for i in range(1, len(real)):
-        real[i] = max(real[i], real[i - 1] * 1.01)
-    return [complex(-v) for v in real] + [a for a in out if a.imag != 0]
-
-
-def _stable_sqrt(v) -> complex:
-    """The root of ``s^2 = -v`` in the closed left half plane."""
-    r = np.sqrt(-complex(v))
-    return complex(-abs(r.real), r.imag)
+#: the fitted D scaling of one block (:func:`mutext.frfit.fit_magnitude`)
+DScaleFit = MagnitudeFit
 
 
 def fit_dscale(omega, mag, order: int, weight=None, iterations: int = 8) -> DScaleFit:
     r"""Fit :math:`|\hat D(j\omega)| \approx` ``mag`` by a stable, minimum-phase, biproper :math:`\hat D`.
 
-    Parameters
-    ----------
-    omega : array_like
-        Positive frequencies (rad/s).
-    mag : array_like
-        Positive magnitudes.
-    order : int
-        0 (a constant) to 5.
-    weight : array_like, optional
-        Positive weight of each frequency on the error of :math:`\log|\hat D|`
-        (default 1).
-    iterations : int
-        Largest number of vector-fitting pole relocations.
-
-    Returns
-    -------
-    DScaleFit
-        Its poles and zeros lie within the band of ``omega`` in magnitude: a
-        root beyond the band acts there as a constant (or as ``s``) and is moved
-        to the band's edge with the gain compensated; a zero and a pole that
-        meet at an edge cancel, so the fit's order can be below ``order``.
-
-    Raises
-    ------
-    ModelError
-        Empty or mismatched data, non-positive frequencies or magnitudes,
-        order outside 0-5.
-    SolverError
-        The constrained fit failed or gave no valid spectral factor.
-
-    Notes
-    -----
-    With :math:`x = (\omega/\omega_0)^2` the target :math:`\Phi_k = \text{mag}_k^2`
-    is approximated by :math:`\Phi(x) = c_0 + \sum_i c_i/(x - a_i)`; the poles
-    :math:`a_i` (negative real, or complex pairs with damping ratio of the
-    resulting :math:`\hat D` poles at least 0.1) come from vector fitting with
-    relative weighting, the residues from a convex least-squares problem with
-    :math:`\Phi \ge 0` on a dense grid.  As :math:`x = -s^2`, every pole and
-    zero :math:`\xi` of :math:`\Phi` gives the root of :math:`\hat D` that is the
-    left-half-plane solution of :math:`s^2 = -\xi\,\omega_0^2`, and
-    :math:`\hat D(\infty) = \sqrt{c_0}`.
-
-    Examples
-    --------
-    >>> import numpy as np
-    >>> w = np.logspace(-2, 3, 60)
-    >>> fit = fit_dscale(w, np.abs((1j * w + 1) / (1j * w + 10)), 1)
-    >>> np.round(fit.zeros.real, 6), np.round(fit.poles.real, 6), round(fit.gain, 6)
-    (array([-1.]), array([-10.]), 1.0)
+    The vector fit of :func:`mutext.frfit.fit_magnitude` (same parameters,
+    result and errors), on :math:`|\hat D|^2` as a rational function of
+    :math:`\omega^2`, made stable and minimum phase by spectral factorisation.
     """
-    omega = np.asarray(omega, dtype=float).ravel()
-    mag = np.asarray(mag, dtype=float).ravel()
-    if omega.size != mag.size or omega.size == 0:
-        raise ModelError(f"omega and mag must be non-empty and of equal length (got {omega.size} "
-                         f"and {mag.size})")
-    if not (np.all(np.isfinite(omega)) and np.all(omega > 0)):
-        raise ModelError("D-scale fit: frequencies must be positive and finite")
-    if not (np.all(np.isfinite(mag)) and np.all(mag > 0)):
-        raise ModelError("D-scale fit: magnitudes must be positive and finite")
-    if not (isinstance(order, (int, np.integer)) and 0 <= order <= 5):
-        raise ModelError(f"D-scale order must be an integer between 0 and 5, got {order!r}")
-    if weight is None:
-        weight = np.ones_like(omega)
-    else:
-        weight = np.asarray(weight, dtype=float).ravel()
-        if weight.size != omega.size or not np.all(np.isfinite(weight)) or np.any(weight <= 0):
-            raise ModelError("D-scale fit: weight must be positive, finite and one per frequency")
-    order = int(order)
-    if order == 0:
-        # the weighted least-squares constant for log|D|
-        g = float(np.exp(np.sum(weight ** 2 * np.log(mag)) / np.sum(weight ** 2)))
-        fit = DScaleFit(_constant(g), 0, 0.0, np.zeros(0, complex), np.zeros(0, complex), g)
-        fit.error = _log_fit_error(fit, omega, mag, weight)
-        return fit
-    w0 = float(np.exp(np.mean(np.log(omega))))
-    x = (omega / w0) ** 2
-    Phi = mag ** 2
-    # relative error of Phi is about twice the error of log|D|
-    rw = weight / Phi
-    xmin, xmax = x.min(), x.max()
-    poles = [complex(-v) for v in np.logspace(np.log10(xmin), np.log10(xmax), order + 2)[1:-1]]
-    for _ in range(iterations):
-        B = _pf_basis(x, poles)
-        A = np.hstack([np.ones((x.size, 1)), B, -Phi[:, None] * B]) * rw[:, None]
-        cs = 1.0 / np.max(np.abs(A), axis=0)
-        sol, *_ = np.linalg.lstsq(A * cs, Phi * rw, rcond=None)
-        e = (sol * cs)[1 + order:]
-        Ap, bp = _pf_state(poles)
-        new = _admissible(np.linalg.eigvals(Ap - np.outer(bp, e)), xmin, xmax)
-        converged = len(new) == len(poles) and np.allclose(
-            np.sort_complex(np.array(new)), np.sort_complex(np.array(poles)), rtol=1e-6)
-        poles = new
-        if converged:
-            break
-    B = _pf_basis(x, poles)
-    A = np.hstack([np.ones((x.size, 1)), B]) * rw[:, None]
-    # column scaling: the basis functions differ by decades in size
-    cs = 1.0 / np.max(np.abs(A), axis=0)
-    coef, *_ = np.linalg.lstsq(A * cs, Phi * rw, rcond=None)
-    coef = coef * cs
-    xd = np.concatenate([[0.0], np.logspace(np.log10(xmin) - 3, np.log10(xmax) + 3, 400)])
-    Bd = np.hstack([np.ones((xd.size, 1)), _pf_basis(xd, poles)])
-    floor = 1e-3 * Phi.min()
-    if coef[0] <= floor or np.any(Bd @ coef < floor):
-        import cvxpy as cp
-        c = cp.Variable(order + 1)
-        prob = cp.Problem(cp.Minimize(cp.sum_squares((A * cs) @ c - Phi * rw)),
-                          [(Bd * cs) @ c >= floor, c[0] * cs[0] >= floor])
-        try:
-            prob.solve(solver="CLARABEL")
-        except cp.SolverError as exc:
-            raise SolverError(f"D-scale fit of order {order}: the convex fit failed ({exc})") from None
-        if c.value is None:
-            raise SolverError(f"D-scale fit of order {order}: the convex fit failed (status {prob.status})")
-        coef = np.asarray(c.value, float) * cs
-    c0, ci = max(coef[0], floor), coef[1:]
-    # zeros of Phi(x) = c0 (1 + (ci / c0)^T (xI - Ap)^-1 bp): eigenvalues of Ap - bp ci^T / c0
-    Ap, bp = _pf_state(poles)
-    xi = np.linalg.eigvals(Ap - np.outer(bp, ci) / c0)
-    if np.any((np.abs(xi.imag) <= 1e-9 * np.abs(xi)) & (xi.real > 0)):
-        # a simple root at x > 0 means Phi changes sign between the dense grid points
-        raise SolverError(f"D-scale fit of order {order}: |D|^2 is not positive on the whole axis")
-    # x = -s^2: each root of Phi gives the stable one of s = +/- sqrt(-root)
-    zs = [_stable_sqrt(v) * w0 for v in xi]
-    pz = []
-    for a in poles:
-        pz += [_stable_sqrt(a) * w0] if a.imag == 0 else [_stable_sqrt(a) * w0, _stable_sqrt(a.conjugate()) * w0]
-    poles = np.array(pz, dtype=complex)
-    zeros = np.array(zs)
-    # conjugate pairs must be exact for a real realisation
-    zeros = np.where(np.abs(zeros.imag) < 1e-9 * np.abs(zeros), zeros.real + 0j, zeros)
-    if np.any(zeros.real >= -1e-9 * np.abs(zeros)):
-        raise SolverError(f"D-scale fit of order {order}: a zero of the fit lies on the imaginary axis")
-    gain = float(np.sqrt(c0))
-    # Roots far outside the data only act as constants (above) or as s (below)
-    # there, but they spread the eigenvalues of the scaled plant over many
-    # decades, which the K step's LMIs do not tolerate: move them to the edge
-    # of the data band, keeping the in-band magnitude (the gain absorbs |r|/edge).
-    # A zero and a pole moved to the same edge cancel and are dropped.
-    lo, hi = omega.min(), omega.max()
-
-    def clip(roots, sign):
-        nonlocal gain
-        out = []
-        for r in roots:
-            if abs(r) > hi:
-                gain *= (abs(r) / hi) ** sign
-                out.append(-hi + 0j)
-            elif abs(r) < lo:
-                out.append(-lo + 0j)
-            else:
-                out.append(r)
-        return out
-    zl, pl = clip(zeros, 1), clip(poles, -1)
-    for edge in (-hi + 0j, -lo + 0j):
-        while edge in zl and edge in pl:
-            zl.remove(edge)
-            pl.remove(edge)
-    zeros, poles = np.array(zl, dtype=complex), np.array(pl, dtype=complex)
-    fit = DScaleFit(_zpk_ss(zeros, poles, gain), len(poles), 0.0, zeros, poles, gain)
-    fit.error = _log_fit_error(fit, omega, mag, weight)
-    return fit
+    return fit_magnitude(omega, mag, order, weight=weight, iterations=iterations)
 
 
 def fit_dscale_auto(omega, mag, weight=None, max_order: int = 4, tol: float = 0.05) -> DScaleFit:
@@ -505,7 +212,7 @@ def _norms_and_grads(H, S: BlockStructure, X):
 
 
 def _sweep_upper(H, S: BlockStructure, X0=None, tol: float = 1e-6, max_iter: int = 2000,
-                 radius: float = 8.0):
+                 radius: float = 8.0, progress=None):
     r"""Diagonal-D upper bound of mu at every frequency at once.
 
     The same problem as ``mu_upper(method="osborne")`` (minimise the convex
@@ -514,6 +221,9 @@ def _sweep_upper(H, S: BlockStructure, X0=None, tol: float = 1e-6, max_iter: int
     parallel (one batched SVD per step), started from ``X0`` (the previous
     iteration's scalings) or from Osborne balancing.  Each value is
     :math:`\bar\sigma(DMD^{-1})` for the returned :math:`D`, so a valid bound.
+
+    ``progress(fraction)``, if given, is called every 50 steps with the
+    fraction of frequencies converged.
 
     Returns
     -------
@@ -551,10 +261,12 @@ def _sweep_upper(H, S: BlockStructure, X0=None, tol: float = 1e-6, max_iter: int
     P = np.repeat((radius ** 2 * np.eye(n))[None], nw, axis=0)
     lower = np.full(nw, -np.inf)
     active = np.ones(nw, bool)
-    for _ in range(max_iter):
+    for step in range(max_iter):
         idx = np.flatnonzero(active)
         if idx.size == 0:
             break
+        if progress is not None and step % 50 == 0:
+            progress(1.0 - idx.size / nw)
         s, g = _norms_and_grads(H[idx], S, X[idx])
         f = np.log(np.maximum(s, 1e-300))
         better = f < best_f[idx]
@@ -613,13 +325,14 @@ _GOOD = 0.5
 
 
 def _d_step(omega, H, S: BlockStructure, X, upper, max_order: int, fit_tol: float,
-            budget: int, reach: float = np.log(100.0), rounds: int = 4):
+            budget: int, reach: float = np.log(100.0), rounds: int = 4, progress=None):
     """Rational scalings for the next K step (see the module docstring).
 
     ``budget`` bounds the states the scalings add to the plant (a block of
     size ``rows x cols`` with a fit of order ``n`` adds ``n (rows + cols)``).
     Returns the list of fits (``None`` for the last block) and the peak of
     sigma_max(D_fit M D_fit^-1) on the grid, the level the next K step starts from.
+    ``progress(text)``, if given, is called before each fit.
     """
     level = float(np.max(upper)) * (1.0 + fit_tol)
     lo, hi = _intervals(H, S, X, level, reach)
@@ -634,6 +347,8 @@ def _d_step(omega, H, S: BlockStructure, X, upper, max_order: int, fit_tol: floa
 
         def fit(k, n):
             if (k, n) not in cache:
+                if progress is not None:
+                    progress(f"block {k + 1}/{m - 1}, order {n}")
                 try:
                     cache[k, n] = fit_dscale(omega, np.exp(center[:, k]), n, weight=1.0 / half[:, k])
                 except (SolverError, ModelError, np.linalg.LinAlgError):
@@ -699,9 +414,12 @@ class DKResult:
         complex.  Each point is :math:`\bar\sigma(DMD^{-1})` for an explicit
         :math:`D`, hence a certified bound at that frequency.
     mu_upper_dg : float
-        Upper bound for the structure with its real blocks (D-G scalings at
-        the highest frequencies, the complex bound elsewhere); equal to
-        ``mu_upper`` without real blocks or with ``dg=False``.
+        Upper bound for the structure with its real blocks: the peak over
+        the final grid of the lower of the D-G bound
+        (``mutext.mu.mu_upper(method="fast")``, computed from the largest
+        complex values down until the next cannot raise the peak, at most 24)
+        and the complex bound; equal to ``mu_upper`` without real blocks or
+        with ``dg=False``.
     mu_lower : float
         Peak lower bound for the structure as given (real blocks real); a
         perturbation achieving it is ``sweep.lower_delta``.
@@ -712,11 +430,17 @@ class DKResult:
         Frequency (rad/s) of ``mu_upper``.
     history : list of dict
         Per iteration: ``iteration``, ``gamma`` (K-step level), ``mu`` (peak
-        upper bound on the D-step grid), ``orders`` (D-fit orders used in
-        that K step), ``fit_peak`` (peak of the fitted-scaled closed loop of
-        the previous controller, the level the K step starts from),
-        ``controller_order``, ``method`` (``"lmi"`` or ``"riccati"``: the
-        K-step synthesis that succeeded), ``seconds``.
+        upper bound on the D-step grid, real parameters as complex),
+        ``mu_dg`` (the same with D-G scalings for the real blocks:
+        ``mutext.mu.mu_upper(method="fast")`` from the largest complex values
+        down, capped pointwise by the complex bound; equal to ``mu`` without
+        real blocks or with ``dg=False``), ``orders`` (D-fit orders used in
+        that K step), ``g_orders`` (G-fit orders of the real blocks: None,
+        the iteration scales real blocks as complex), ``plant_states``
+        (states of the scaled K-step plant), ``fit_peak`` (peak of the
+        fitted-scaled closed loop of the previous controller, the level the K
+        step starts from), ``controller_order``, ``method`` (``"lmi"`` or
+        ``"riccati"``: the K-step synthesis that succeeded), ``seconds``.
     sweep : MuSweep
         Final fine-grid analysis (complex upper bound; lower bound fields
         for the given structure).
@@ -807,13 +531,14 @@ def _local_maxima(values, count):
     return sorted(pk, key=lambda i: -v[i])[:count]
 
 
-def _fine_sweep(CL, S: BlockStructure, omega, npeaks: int = 4, rounds: int = 3, points: int = 16) -> MuSweep:
+def _fine_sweep(CL, S: BlockStructure, omega, npeaks: int = 4, rounds: int = 3, points: int = 16,
+                progress=None) -> MuSweep:
     """Diagonal-D upper bound on ``omega`` with its largest local maxima refined:
     ``rounds`` times, ``points`` log-spaced frequencies between the neighbours of
     each peak are added (each round shrinks the spacing there by ``points + 1``)."""
     w = np.unique(np.asarray(omega, float))
     H = np.moveaxis(freqresp(CL, w), -1, 0)
-    up, X = _sweep_upper(H, S)
+    up, X = _sweep_upper(H, S, progress=progress)
     for _ in range(rounds):
         new = []
         for i in _local_maxima(up, npeaks):
@@ -838,11 +563,32 @@ def _fine_sweep(CL, S: BlockStructure, omega, npeaks: int = 4, rounds: int = 3, 
                    float("nan"), float("nan"), None, ["osborne"] * w.size)
 
 
-def _final_analysis(CL, S: BlockStructure, grid, final_points: int, dg: bool, npeaks: int = 4):
-    """Certified complex upper bound on a fine grid, lower bounds and the D-G bound at the peaks."""
+def _dg_peak(H, S: BlockStructure, upper, limit: int = 24) -> float:
+    """Peak over the grid of min(D-G bound, complex bound ``upper``), both certified at each
+    frequency.  The D-G bound (``mutext.mu.mu_upper(method="fast")``) is computed from the
+    largest complex values down, until the next complex value cannot raise the peak; after
+    ``limit`` frequencies the next complex value counts as it is."""
+    order = np.argsort(-np.asarray(upper))
+    best = 0.0
+    for n, k in enumerate(order):
+        if upper[k] <= best:
+            break
+        if n >= limit:
+            best = float(upper[k])
+            break
+        best = max(best, min(mu_upper(H[k], S, method="fast").value, float(upper[k])))
+    return float(best)
+
+
+def _final_analysis(CL, S: BlockStructure, grid, final_points: int, dg: bool, npeaks: int = 4,
+                    report=None):
+    """Certified complex upper bound on a fine grid, lower bounds at the peaks and the D-G bound."""
+    report = report or (lambda stage, fraction: None)
     Sc = S.complexified()
     fine = np.unique(np.concatenate([default_grid(CL, n=final_points, decades=1.5), grid]))
-    final = _fine_sweep(CL, Sc, fine, npeaks=npeaks)
+    final = _fine_sweep(CL, Sc, fine, npeaks=npeaks,
+                        progress=lambda f: report(f"final-analysis: mu sweep, {fine.size} frequencies", 0.4 * f))
+    report("final-analysis: lower bounds at the peaks", 0.4)
     ups = final.upper
     wpk = final.omega[_local_maxima(ups, npeaks)]
     low_c = mu_sweep(CL, Sc, wpk, method="osborne", lower="all", refine=False)
@@ -854,18 +600,8 @@ def _final_analysis(CL, S: BlockStructure, grid, final_points: int, dg: bool, np
     final.lower_delta = low.lower_delta
     mu_dg = float(final.peak_upper)
     if S.has_real and dg:
-        # D-G <= complex bound at every frequency: evaluate D-G from the highest
-        # complex values down until the next complex value cannot raise the peak
-        order = np.argsort(-ups)
-        budget = min(12, order.size)
-        H = freqresp(CL, final.omega[order[:budget]])
-        best_dg, k = 0.0, 0
-        while k < budget and ups[order[k]] > best_dg:
-            v = mu_upper(H[:, :, k], S, method="lmi", real="dg", rtol=1e-5).value
-            best_dg = max(best_dg, min(v, ups[order[k]]))
-            k += 1
-        rest = ups[order[k]] if k < order.size else 0.0
-        mu_dg = float(max(best_dg, rest))
+        report("final-analysis: D-G bound", 0.7)
+        mu_dg = _dg_peak(np.moveaxis(freqresp(CL, final.omega), -1, 0), S, ups)
     return final, float(low.peak_lower), float(low_c.peak_lower), mu_dg
 
 
@@ -873,7 +609,7 @@ def dk_iteration(P, structure: BlockStructure, nmeas: int, ncon: int, *, omega=N
                  max_iter: int = 8, max_order: int = 4, max_states: int | None = None,
                  fit_tol: float = 0.02, rel_improvement: float = 0.01, patience: int = 1,
                  grid_points: int = 80, final_points: int = 200, dg: bool = True,
-                 synthesis=None, out=None) -> DKResult:
+                 synthesis=None, out=None, progress=None) -> DKResult:
     r"""D-K iteration for robust performance.
 
     Parameters
@@ -922,6 +658,20 @@ def dk_iteration(P, structure: BlockStructure, nmeas: int, ncon: int, *, omega=N
         ``K`` and ``gamma``.
     out : file or None
         Where the per-iteration table is printed (default None: silent; the demos pass sys.stderr).
+        Columns: iteration, K-step level, peak mu on the grid (and with real
+        blocks its D-G bound), the D-fit orders (and G-fit orders with real
+        blocks: "-", the K steps scale real blocks as complex) of the scalings
+        used in that K step, controller order, states of the scaled plant and
+        seconds.
+    progress : callable, optional
+        ``progress(stage, fraction)``, called during the slow steps (e.g.
+        :class:`mutext.progress.ProgressLine`): the K step (``"K-step ..."``;
+        the SDP solve cannot report itself, so a helper thread calls
+        ``progress`` about once a second with the elapsed time), the mu sweep
+        over the grid (``"mu-sweep ..."``, with the fraction of frequencies
+        converged), the D fits (``"D-fit ..."``, one call per fit) and the
+        final analysis (``"final-analysis ..."``).  ``fraction`` is the
+        overall fraction done (iterations up to ``max_iter`` share 0-0.9).
 
     Returns
     -------
@@ -972,45 +722,99 @@ def dk_iteration(P, structure: BlockStructure, nmeas: int, ncon: int, *, omega=N
         raise ModelError(f"synthesis must be 'lmi', 'riccati' or a callable, got {synthesis!r}")
     with blas_single_thread():
         return _dk(P, S, nmeas, ncon, omega, max_iter, max_order, max_states - P.nstates, fit_tol,
-                   rel_improvement, patience, grid_points, final_points, dg, synth, out, t0)
+                   rel_improvement, patience, grid_points, final_points, dg, synth, out, t0, progress)
+
+
+class _Heartbeat:
+    """While a step that cannot report itself runs (the K step's SDP solve), call
+    ``progress(stage(elapsed), fraction)`` at its start and about every ``period``
+    seconds from a helper thread."""
+
+    def __init__(self, progress, stage, fraction: float, period: float = 1.0):
+        self.progress, self.stage, self.fraction, self.period = progress, stage, fraction, period
+        self.thread = None
+
+    def __enter__(self):
+        if self.progress is None:
+            return self
+        import threading
+        self.t0 = time.perf_counter()
+        self.stop = threading.Event()
+        self.progress(self.stage(0.0), self.fraction)
+
+        def beat():
+            while not self.stop.wait(self.period):
+                self.progress(self.stage(time.perf_counter() - self.t0), self.fraction)
+        self.thread = threading.Thread(target=beat, daemon=True)
+        self.thread.start()
+        return self
+
+    def __exit__(self, *exc):
+        if self.thread is not None:
+            self.stop.set()
+            self.thread.join()
+        return False
 
 
 def _dk(P, S, nmeas, ncon, grid, max_iter, max_order, budget, fit_tol, rel_improvement, patience,
-        grid_points, final_points, dg, synth, out, t0):
+        grid_points, final_points, dg, synth, out, t0, on_progress=None):
     Sc = S.complexified()
     if grid is None:
         grid = _default_dk_grid(P, grid_points)
+
+    def at(it, part):
+        """Overall fraction at ``part`` (0-1) of iteration ``it``."""
+        return 0.9 * (it - 1 + part) / max_iter
+
+    def report(stage, fraction):
+        if on_progress is not None:
+            on_progress(stage, min(max(fraction, 0.0), 1.0))
+
+    def kstep(it, PD):
+        stage = (lambda el: f"K-step {it}/{max_iter}: H-infinity synthesis, {PD.nstates} states, {el:.0f} s")
+        with _Heartbeat(on_progress, stage, at(it, 0.0)):
+            return synth(PD, nmeas, ncon)
+
+    def dstep(it, H, X, upper, order):
+        return _d_step(grid, H, S, X, upper, order, fit_tol, budget,
+                       progress=lambda text: report(f"D-fit {it}/{max_iter}: {text}", at(it, 0.9)))
+    real_blocks = [k for k, b in enumerate(S.blocks) if b.kind == "real"]
+    gcol = f" {'G-fit orders':>13}" if real_blocks else ""
+    dgcol = f" {'mu D-G':>8}" if real_blocks and dg else ""
     Xd = None          # log D scalings on the grid, the next sweep's starting point
     fits = [None] * len(S)
     fit_peak = float("nan")
     history, notes = [], []
     best = None
     stall = 0
-    _print(out, f"{'iter':>4} {'gamma (K step)':>15} {'peak mu':>10} {'D-fit orders':>18} "
-                f"{'K order':>8} {'seconds':>8}")
+    _print(out, f"{'iter':>4} {'gamma (K step)':>15} {'peak mu':>10}{dgcol} {'D-fit orders':>18}{gcol} "
+                f"{'K order':>8} {'plant':>6} {'seconds':>8}")
     for it in range(1, max_iter + 1):
         ti = time.perf_counter()
         orders = [0 if f is None else f.order for f in fits[:-1]]
         PD = P if it == 1 else scaled_plant(P, S, fits, nmeas, ncon)
         try:
             try:
-                res = synth(PD, nmeas, ncon)
+                res = kstep(it, PD)
             except (InfeasibleError, SolverError, IllPosedError) as exc:
                 if best is None or not any(orders):
                     raise
                 # Lower-order scalings spread the scaled plant's eigenvalues less,
                 # which is what usually defeats the LMI solver: retry once.
                 first = f"iteration {it}: the K step failed with D-fit orders {orders} ({exc})"
-                fits, fit_peak = _d_step(grid, H, S, Xd, upper, max(orders) - 1, fit_tol, budget)
+                fits, fit_peak = dstep(it, H, Xd, upper, max(orders) - 1)
                 orders = [f.order for f in fits[:-1]]
-                res = synth(scaled_plant(P, S, fits, nmeas, ncon), nmeas, ncon)
+                PD = scaled_plant(P, S, fits, nmeas, ncon)
+                res = kstep(it, PD)
                 notes.append(first + f"; retried with orders {orders}")
         except (InfeasibleError, SolverError, IllPosedError) as exc:
             if best is None:
                 raise
             notes.append(f"iteration {it}: the K step failed ({exc}); kept iteration {best[4]}")
             history.append({"iteration": it, "gamma": float("nan"), "mu": float("nan"),
-                            "orders": orders, "fit_peak": fit_peak, "controller_order": None,
+                            "mu_dg": float("nan"), "orders": orders,
+                            "g_orders": [None] * len(real_blocks), "plant_states": int(PD.nstates),
+                            "fit_peak": fit_peak, "controller_order": None,
                             "method": None, "seconds": time.perf_counter() - ti, "error": str(exc)})
             msg = str(exc)
             _print(out, f"{it:>4}  K step failed: {msg[:90] + ' ...' if len(msg) > 90 else msg}")
@@ -1028,9 +832,17 @@ def _dk(P, S, nmeas, ncon, grid, max_iter, max_order, budget, fit_tol, rel_impro
             _print(out, f"{it:>4}  {exc}")
             break
         H = np.moveaxis(freqresp(CL, grid), -1, 0)
-        upper, Xd = _sweep_upper(H, Sc, Xd)
+        upper, Xd = _sweep_upper(H, Sc, Xd, progress=lambda f: report(
+            f"mu-sweep {it}/{max_iter}: {grid.size} frequencies, {100 * f:.0f} % converged", at(it, 0.6 + 0.3 * f)))
         mu_pk = float(upper.max())
-        row = {"iteration": it, "gamma": float(res.gamma), "mu": mu_pk, "orders": orders,
+        mu_dg_pk = mu_pk
+        if real_blocks and dg:
+            # the bound with the real blocks real (fast D-G sweep, no LMI check), pointwise
+            # no higher than the complex one: both are certified at each frequency
+            report(f"mu-sweep {it}/{max_iter}: D-G bound at the peaks", at(it, 0.9))
+            mu_dg_pk = _dg_peak(H, S, upper)
+        row = {"iteration": it, "gamma": float(res.gamma), "mu": mu_pk, "mu_dg": mu_dg_pk, "orders": orders,
+               "g_orders": [None] * len(real_blocks), "plant_states": int(PD.nstates),
                "fit_peak": fit_peak, "controller_order": int(K.nstates),
                "method": getattr(res, "method", "custom"),
                "seconds": time.perf_counter() - ti}
@@ -1044,19 +856,23 @@ def _dk(P, S, nmeas, ncon, grid, max_iter, max_order, budget, fit_tol, rel_impro
         if not stop:
             # D step on the new closed loop
             try:
-                fits_new, fit_peak = _d_step(grid, H, S, Xd, upper, max_order, fit_tol, budget)
+                fits_new, fit_peak = dstep(it, H, Xd, upper, max_order)
             except SolverError as exc:
                 notes.append(f"iteration {it}: {exc}")
                 stop = True
             else:
                 fits = fits_new
         row["seconds"] = time.perf_counter() - ti
-        _print(out, f"{it:>4} {res.gamma:>15.5f} {mu_pk:>10.5f} {str(orders):>18} {K.nstates:>8} "
-                    f"{row['seconds']:>8.2f}")
+        gtxt = f" {'-':>13}" if real_blocks else ""
+        dgtxt = f" {mu_dg_pk:>8.5f}" if dgcol else ""
+        _print(out, f"{it:>4} {res.gamma:>15.5f} {mu_pk:>10.5f}{dgtxt} {str(orders):>18}{gtxt} {K.nstates:>8} "
+                    f"{PD.nstates:>6} {row['seconds']:>8.2f}")
         if stop:
             break
     mu_pk, K, CL, used_fits, best_it = best
-    final, low, low_c, mu_dg = _final_analysis(CL, S, grid, final_points, dg)
+    final, low, low_c, mu_dg = _final_analysis(CL, S, grid, final_points, dg,
+                                               report=lambda stage, f: report(stage, 0.9 + 0.1 * f))
+    report("final-analysis: done", 1.0)
     _print(out, f"best: iteration {best_it}, controller order {K.nstates}; fine grid: "
                 f"{low:.4f} <= mu <= {final.peak_upper:.4f}"
                 + (" (real parameters as complex)" if S.has_real else "")

@@ -136,11 +136,16 @@ def siso_rp_plant():
 SISO_S = BlockStructure([Block.full(1, 1, "input uncertainty"), Block.full(1, 1, "performance")])
 
 
+PROGRESS = []
+
+
 @pytest.fixture(scope="module")
 def siso_dk():
     P = siso_rp_plant()
     out = io.StringIO()
-    return P, dk_iteration(P, SISO_S, 1, 1, out=out), out.getvalue()
+    PROGRESS.clear()
+    res = dk_iteration(P, SISO_S, 1, 1, out=out, progress=lambda stage, f: PROGRESS.append((stage, f)))
+    return P, res, out.getvalue()
 
 
 def test_dk_reduces_mu(siso_dk):
@@ -174,6 +179,40 @@ def test_dk_prints_iteration_table(siso_dk):
     assert "gamma" in lines[0] and "peak mu" in lines[0] and "D-fit orders" in lines[0]
     assert len(lines) >= len(res.history) + 2
     assert lines[-1].startswith("best:")
+
+
+def test_dk_reports_progress_in_its_slow_steps(siso_dk):
+    _, res, text = siso_dk
+    stages = [s for s, _ in PROGRESS]
+    fractions = np.array([f for _, f in PROGRESS])
+    for head in ("K-step", "mu-sweep", "D-fit", "final-analysis"):
+        assert any(s.startswith(head) for s in stages), head
+    # every K step and every D step of the table was announced
+    assert sum(s.startswith("K-step") and s.endswith(" 0 s") for s in stages) >= len(res.history)
+    assert np.all((fractions >= 0) & (fractions <= 1))
+    assert np.all(np.diff(fractions) >= -1e-12)        # overall progress never goes back
+    assert stages[-1].startswith("final-analysis") and fractions[-1] == 1.0
+    header = text.strip().splitlines()[0]
+    assert "K order" in header and "plant" in header and "seconds" in header
+    assert all(h["plant_states"] >= res.history[0]["plant_states"] for h in res.history)
+
+
+def test_dk_progress_beats_during_a_slow_k_step():
+    """The K step cannot report itself: a helper thread reports its elapsed time."""
+    import time
+
+    from mutext.hinf import hinfsyn
+
+    def slow(PD, nmeas, ncon):
+        time.sleep(1.6)
+        return hinfsyn(PD, nmeas, ncon)
+    calls = []
+    res = dk_iteration(siso_rp_plant(), SISO_S, 1, 1, max_iter=1, synthesis=slow,
+                       progress=lambda stage, f: calls.append(stage))
+    assert len(res.history) == 1
+    kstep = [s for s in calls if s.startswith("K-step 1/1")]
+    seconds = [int(s.split()[-2]) for s in kstep]
+    assert seconds[0] == 0 and max(seconds) >= 1 and len(seconds) >= 2
 
 
 def test_dk_fits_track_the_optimal_scalings(siso_dk):

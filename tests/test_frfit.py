@@ -188,3 +188,25 @@ def test_noise_level_bad_input():
 def test_resonances_docstring_example():
     result = doctest.testmod(frfit, optionflags=doctest.ELLIPSIS)
     assert result.attempted > 0 and result.failed == 0
+
+
+# --- magnitude-only fits (mutext.frfit.fit_magnitude, the D scalings of mutext.dk) -----------
+
+def test_magnitude_fit_of_non_minimum_phase_system_is_its_minimum_phase_factor():
+    import control as ct
+    # |G| of G = 2 (s - 3)(s^2 + 0.4 s + 4) / ((s + 0.5)(s^2 + 1.2 s + 25)) equals |G_mp|
+    # with the zero at +3 reflected to -3: the fit must recover G_mp's zeros and poles
+    G = ct.tf(2 * np.polymul([1, -3], [1, 0.4, 4]), np.polymul([1, 0.5], [1, 1.2, 25]))
+    w = np.logspace(-2, 2.5, 120)
+    mag = np.abs(freqresp(ct.ss(G), w)[0, 0])
+    fit = frfit.fit_magnitude(w, mag, 3)
+    assert fit.order == 3
+    np.testing.assert_allclose(np.sort_complex(fit.zeros), np.sort_complex([-3, -0.2 + np.sqrt(3.96) * 1j,
+                                                                            -0.2 - np.sqrt(3.96) * 1j]), rtol=1e-6)
+    np.testing.assert_allclose(np.sort_complex(fit.poles), np.sort_complex(ct.poles(G)), rtol=1e-6)
+    assert fit.gain == pytest.approx(2.0, rel=1e-6)
+    # the realisation, checked by python-control: stable, minimum phase, the data's magnitude
+    assert np.all(ct.poles(fit.sys).real < 0) and np.all(ct.zeros(fit.sys).real < 0)
+    np.testing.assert_allclose(np.abs(ct.frequency_response(fit.sys, w).magnitude).ravel(), mag, rtol=1e-6)
+    np.testing.assert_allclose(np.abs(ct.frequency_response(fit.inverse(), w).magnitude).ravel(), 1 / mag,
+                               rtol=1e-6)

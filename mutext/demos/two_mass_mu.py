@@ -60,13 +60,32 @@ def check_controller(K, x_max: float, rel: float = 0.02) -> dict:
     }
 
 
-def solve(x_max: float = 0.035, max_iter: int = 6, out=sys.stderr) -> dict:
-    """Run the D-K iteration and the checks; everything the demo and the tests report."""
+class _TableBelowProgress:
+    """A stream for the iteration table that first clears the progress line on a terminal."""
+
+    def __init__(self, progress, stream=sys.stderr):
+        self.progress, self.stream, self.fresh = progress, stream, True
+
+    def write(self, text):
+        if self.fresh and self.progress.tty and self.progress.enabled:
+            self.stream.write("\r" + " " * 110 + "\r")
+        self.stream.write(text)
+        self.fresh = text.endswith("\n")
+
+    def flush(self):
+        self.stream.flush()
+
+
+def solve(x_max: float = 0.035, max_iter: int = 6, out=sys.stderr, progress=None) -> dict:
+    """Run the D-K iteration and the checks; everything the demo and the tests report.
+
+    ``progress(stage, fraction)`` is passed to :func:`mutext.dk.dk_iteration`."""
     t0 = time.perf_counter()
     P = tmu.plant(x_max)
     # a scaling budget of 16 added states (the default is 12): on this problem it
     # reaches a lower mu in less time (benchmarks/bench_dk.py)
-    res = dk_iteration(P, tmu.structure(), 1, 1, max_iter=max_iter, max_states=P.nstates + 16, out=out)
+    res = dk_iteration(P, tmu.structure(), 1, 1, max_iter=max_iter, max_states=P.nstates + 16, out=out,
+                       progress=progress)
     t_dk = time.perf_counter() - t0
     check = check_controller(res.K, x_max)
     poles = np.linalg.eigvals(np.asarray(res.K.A, float)) if res.K.nstates else np.zeros(0)
@@ -102,7 +121,9 @@ def run(args) -> int:
         raise ModelError(f"--max-iter must be at least 1, got {args.max_iter}")
     print(f"two-mass mu-synthesis (thesis sec. 2.3.2): m1, m2, k1, k2 +/- 2 %, x1 < {args.xmax} m; "
           "D-K iteration:", file=sys.stderr, flush=True)
-    out = solve(args.xmax, args.max_iter, out=sys.stderr)
+    from ..progress import ProgressLine
+    prog = ProgressLine()
+    out = solve(args.xmax, args.max_iter, out=_TableBelowProgress(prog), progress=prog)
     if args.json:
         from ..jsonio import print_json
         print_json({k: v for k, v in out.items() if k != "result"})
