@@ -47,6 +47,7 @@ References
 from __future__ import annotations
 
 import time
+from collections.abc import Callable
 from dataclasses import dataclass, field
 
 import control as ct
@@ -645,7 +646,7 @@ def identify(true, engineering, *, excitation: str, measurement: str, control_in
              control_output: str, Ww: float = 1.0, Wz: float | None = None, tol: float = 0.05,
              max_tries: int = 8, regularization: float | None = 1e-4, omega=None,
              dk_options: dict | None = None, out=None, time_limit: float | None = None,
-             max_fit_residual: float = 0.2) -> MBIResult:
+             max_fit_residual: float = 0.2, progress: Callable[[str, float], None] | None = None) -> MBIResult:
     r"""Identify the unmodeled dynamics of ``engineering`` by mu-synthesis (thesis sec. 3.5).
 
     Runs D-K iteration on the plant of :func:`mbi_plant` and tunes :math:`W_z`
@@ -678,7 +679,14 @@ def identify(true, engineering, *, excitation: str, measurement: str, control_in
     dk_options : dict, optional
         Passed to :func:`mutext.dk.dk_iteration`.
     out : file or None
-        Progress (one line per try, and the D-K tables); default None: silent (the demos pass a stream).
+        A log of the search (one line per try, and the D-K tables); default
+        None: silent.
+    progress : callable(stage: str, fraction: float), optional
+        Called during the W_z search (e.g. :class:`mutext.progress.ProgressLine`):
+        the D-K stage of each try (passed on to :func:`mutext.dk.dk_iteration`
+        unless ``dk_options`` gives its own ``progress``) and the try's
+        :math:`W_z`, with the fraction of ``max_tries`` spent; the fraction
+        reaches 1 at the end.
     time_limit : float, optional
         Budget in seconds: no new D-K run is started once it is spent (a run
         under way is finished).  The notes of the result report the budget and
@@ -714,8 +722,57 @@ def identify(true, engineering, *, excitation: str, measurement: str, control_in
     >>> bool(r.mu_upper <= 1)                           # the error bound W_z is certified
     True
     """
-    from .dk import dk_iteration
     t0 = time.perf_counter()
+    _check_search_arguments(max_tries, time_limit, tol)
+    say = _logger(out)
+    measured, measured_fit = None, None
+    if isinstance(true, FRF):
+        measured = true
+        true, measured_fit, omega = _true_from_measured(measured, engineering, omega, excitation, measurement,
+                                                        max_fit_residual, say)
+    kw = dict(excitation=excitation, measurement=measurement, control_input=control_input,
+              control_output=control_output, Ww=Ww, regularization=regularization)
+    probe = mbi_plant(true, engineering, Wz=1.0, **kw)
+    omega = _search_grid(probe, omega)
+    diff = _open_loop_difference(probe, omega, excitation, measurement, Ww)
+    floor = wz_floor(true, excitation=excitation, measurement=measurement, Ww=Ww, omega=omega)
+    Wz, notes = _first_wz(Wz, diff, floor)
+    if floor.value > 0:
+        say(f"W_z floor {floor.value:.4g} (spread of {floor.samples} true systems at {floor.omega:.4g} rad/s)")
+    opts = {"max_iter": 4, "out": None if out is None else out}
+    opts.update(dk_options or {})
+    search = _search_wz(lambda w: mbi_plant(true, engineering, Wz=w, **kw), Wz, floor, omega, opts, tol,
+                        max_tries, time_limit, t0, say, progress)
+    best = _best_try(search.tries)
+    plant, res = search.runs[best]
+    if search.failed:
+        notes.append(f"the K step failed at {len(search.failed)} W_z value(s) ("
+                     + ", ".join(f"{w:.4g}" for w, _ in search.failed) + "); the search moved on to looser ones")
+    if measured_fit is not None:
+        notes += _measured_notes(plant, res, measured, measured_fit)
+    notes += _search_notes(search, best, tol, max_tries, time_limit, t0)
+    if plant.eps_u or plant.eps_y:
+        notes.append(f"regularised: control penalty {plant.eps_u:.3g} per unit u, sensor noise "
+                     f"{plant.eps_y:.3g} (the thesis plant is singular)")
+    fit = _fit_on_identifiable_band(plant, res.K, omega, notes)
+    if progress is not None:
+        progress(f"W_z search done: W_z = {search.tries[best].Wz:.4g}, mu <= {search.tries[best].mu_upper:.4f}",
+                 1.0)
+    tries = search.tries
+    return MBIResult(res.K, tries[best].Wz, tries[best].mu_upper, tries[best].mu_lower, tries, plant, fit,
+                     controlled_engineering(plant, res.K), res, time.perf_counter() - t0, omega, notes, floor,
+                     measured_fit)
+
+
+def _logger(out):
+    """``say(text)``: a line ``[mbi] text`` on ``out`` (nothing for ``None``)."""
+    def say(text):
+        if out is not None:
+            print(f"[mbi] {text}", file=out, flush=True)
+    return say
+
+
+def _check_search_arguments(max_tries, time_limit, tol) -> None:
     if isinstance(max_tries, (bool, np.bool_)) or not isinstance(max_tries, (int, np.integer)) or max_tries < 1:
         raise ModelError(f"identify: max_tries must be a positive integer (the number of D-K runs allowed), "
                          f"got {max_tries!r}")
@@ -725,28 +782,29 @@ def identify(true, engineering, *, excitation: str, measurement: str, control_in
         raise ModelError(f"identify: time_limit must be a positive number of seconds or None, got {time_limit!r}")
     if not (isinstance(tol, (int, float, np.integer, np.floating)) and 0 < tol < 1):
         raise ModelError(f"identify: tol must lie in (0, 1), got {tol!r}")
-    measured_fit = None
-    if isinstance(true, FRF):
-        measured = true
-        true, measured_fit = true_from_frf(measured, engineering, excitation=excitation, measurement=measurement,
-                                           max_residual=max_fit_residual)
-        band = 2 * np.pi * np.asarray(measured.freq_hz, float)
-        if omega is None:
-            omega = band
-        else:
-            omega = np.asarray(omega, float)
-            omega = omega[(omega >= band.min()) & (omega <= band.max())]
-            if omega.size == 0:
-                raise ModelError(f"identify: no frequency overlap between the grid and the measured FRF "
-                                 f"({band.min():.4g}-{band.max():.4g} rad/s)")
-        if out is not None:
-            print(f"[mbi] measured FRF: {measured.freq_hz.size} frequencies, "
-                  f"{measured.freq_hz.min():.4g}-{measured.freq_hz.max():.4g} Hz; fitted by a stable "
-                  f"model of order {measured_fit.order} (relative residual {measured_fit.residual:.3g})",
-                  file=out, flush=True)
-    kw = dict(excitation=excitation, measurement=measurement, control_input=control_input,
-              control_output=control_output, Ww=Ww, regularization=regularization)
-    probe = mbi_plant(true, engineering, Wz=1.0, **kw)
+
+
+def _true_from_measured(measured, engineering, omega, excitation, measurement, max_fit_residual, say):
+    """The true system fitted to a measured FRF, and the grid cut to the measured band (default: its points)."""
+    true, measured_fit = true_from_frf(measured, engineering, excitation=excitation, measurement=measurement,
+                                       max_residual=max_fit_residual)
+    band = 2 * np.pi * np.asarray(measured.freq_hz, float)
+    if omega is None:
+        omega = band
+    else:
+        omega = np.asarray(omega, float)
+        omega = omega[(omega >= band.min()) & (omega <= band.max())]
+        if omega.size == 0:
+            raise ModelError(f"identify: no frequency overlap between the grid and the measured FRF "
+                             f"({band.min():.4g}-{band.max():.4g} rad/s)")
+    say(f"measured FRF: {measured.freq_hz.size} frequencies, "
+        f"{measured.freq_hz.min():.4g}-{measured.freq_hz.max():.4g} Hz; fitted by a stable "
+        f"model of order {measured_fit.order} (relative residual {measured_fit.residual:.3g})")
+    return true, measured_fit, omega
+
+
+def _search_grid(probe: MBIPlant, omega) -> np.ndarray:
+    """The grid of the search (default :func:`_default_omega`), checked to cover the systems' modes."""
     omega = _default_omega(probe) if omega is None else np.asarray(omega, float)
     if omega.size == 0:
         raise ModelError("identify: the frequency grid is empty")
@@ -758,6 +816,11 @@ def identify(true, engineering, *, excitation: str, measurement: str, control_in
         raise ModelError(f"identify: no frequency overlap: the grid spans {omega.min():.4g}-{omega.max():.4g} "
                          f"rad/s, the systems' modes lie at {modes.min():.4g}-{modes.max():.4g} rad/s "
                          "(a decade either side is needed to compare their responses)")
+    return omega
+
+
+def _open_loop_difference(probe: MBIPlant, omega, excitation, measurement, Ww) -> float:
+    """Peak open-loop error :math:`|x_t - x_e|` on the grid; an error if the two responses agree."""
     diff = float(np.max(np.abs(freqresp(probe.P, omega)[probe.nunc, probe.nunc])))
     E = probe.engineering
     ref = float(np.max(np.abs(freqresp(E, omega)[list(E.output_labels).index(measurement),
@@ -765,109 +828,143 @@ def identify(true, engineering, *, excitation: str, measurement: str, control_in
     if diff <= 1e-9 * ref:
         raise IllPosedError("the true and engineering responses are identical on the grid "
                             f"(largest difference {diff:.3g} against {ref:.3g}): there is nothing to identify")
-    floor = wz_floor(true, excitation=excitation, measurement=measurement, Ww=Ww, omega=omega)
-    start_notes = []
+    return diff
+
+
+def _first_wz(Wz, diff: float, floor: WzFloor):
+    """The first W_z of the search (default 1 % of the open-loop error), kept above the floor; and notes."""
+    notes = []
     if Wz is None:
         Wz = max(0.01 * diff, 1.1 * floor.value)
     elif Wz <= floor.value:
-        start_notes.append(f"the first W_z {Wz:.4g} is below the floor {floor.value:.4g} set by the "
-                           f"spread of the true systems at {floor.omega:.4g} rad/s (no controller can "
-                           f"reach it); the search started at {1.1 * floor.value:.4g}")
+        notes.append(f"the first W_z {Wz:.4g} is below the floor {floor.value:.4g} set by the "
+                     f"spread of the true systems at {floor.omega:.4g} rad/s (no controller can "
+                     f"reach it); the search started at {1.1 * floor.value:.4g}")
         Wz = 1.1 * floor.value
-    if out is not None and floor.value > 0:
-        print(f"[mbi] W_z floor {floor.value:.4g} (spread of {floor.samples} true systems at "
-              f"{floor.omega:.4g} rad/s)", file=out, flush=True)
-    opts = {"max_iter": 4, "out": None if out is None else out}
-    opts.update(dk_options or {})
-    tries, runs, failed = [], [], []
+    return Wz, notes
+
+
+@dataclass
+class _WzSearch:
+    """What the W_z search did: the tries, their (plant, D-K result), the failed K steps, why it stopped."""
+    tries: list = field(default_factory=list)
+    runs: list = field(default_factory=list)
+    failed: list = field(default_factory=list)
+    stopped_by_time: bool = False
+
+
+def _next_wz(tries, Wz: float, mu: float, lo, hi, target: float) -> float:
+    """The log-log secant step toward ``mu = target`` (slope -1 on the first try), kept in ``(lo, hi)``."""
+    if len(tries) >= 2 and tries[-1].Wz != tries[-2].Wz and tries[-1].mu_upper > 0 and tries[-2].mu_upper > 0:
+        a, b = tries[-2], tries[-1]
+        slope = (np.log(b.mu_upper) - np.log(a.mu_upper)) / (np.log(b.Wz) - np.log(a.Wz))
+        slope = slope if slope < -0.05 else -1.0
+    else:
+        slope = -1.0
+    new = Wz * np.exp((np.log(target) - np.log(max(mu, 1e-12))) / slope)
+    if lo is not None and hi is not None:
+        if not lo < new < hi:
+            new = np.sqrt(lo * hi)
+    elif lo is not None and new <= lo:
+        new = lo * 1.1
+    return float(new)
+
+
+def _try_progress(progress, k: int, max_tries: int, Wz: float):
+    """``progress`` for the D-K run of try ``k`` (0-based): its stages, within the try's share of the bar."""
+    def report(stage, fraction):
+        progress(f"{stage} (W_z try {k + 1}/{max_tries}, W_z = {Wz:.4g})", (k + fraction) / max_tries)
+    return report
+
+
+def _search_wz(plant_at, Wz: float, floor: WzFloor, omega, opts: dict, tol: float, max_tries: int,
+               time_limit, t0: float, say, progress) -> _WzSearch:
+    r"""D-K runs at successive :math:`W_z` until :math:`1 - \text{tol} \le \mu \le 1` (see :func:`identify`)."""
+    from .dk import dk_iteration
+    s = _WzSearch()
     lo = floor.value or None    # Wz with mu > 1 (too tight; the floor is one) / mu <= 1
     hi = None
     target = 1.0 - tol / 2
-    stopped_by_time = False
     for k in range(max_tries):
         if time_limit is not None and k > 0 and time.perf_counter() - t0 > time_limit:
-            stopped_by_time = True
+            s.stopped_by_time = True
             break
-        plant = mbi_plant(true, engineering, Wz=Wz, **kw)
-        if out is not None:
-            print(f"[mbi] try {k + 1}: Wz = {Wz:.4g}", file=out, flush=True)
+        plant = plant_at(Wz)
+        say(f"try {k + 1}: Wz = {Wz:.4g}")
+        run_opts = opts
+        if progress is not None:
+            progress(f"W_z try {k + 1}/{max_tries}: W_z = {Wz:.4g}", k / max_tries)
+            if "progress" not in opts:
+                run_opts = {**opts, "progress": _try_progress(progress, k, max_tries, Wz)}
         ti = time.perf_counter()
         try:
-            res = dk_iteration(plant.P, plant.structure, 1, 1, omega=omega, **opts)
+            res = dk_iteration(plant.P, plant.structure, 1, 1, omega=omega, **run_opts)
         except (SolverError, InfeasibleError) as exc:
             # the controller construction is numerically erratic on some badly scaled plants: a
             # slightly looser W_z is a differently scaled plant, and the search goes on
-            failed.append((Wz, str(exc)))
-            if out is not None:
-                print(f"[mbi]        the K step failed at this W_z ({str(exc)[:90]}...); trying 7 % looser",
-                      file=out, flush=True)
+            s.failed.append((Wz, str(exc)))
+            say(f"       the K step failed at this W_z ({str(exc)[:90]}...); trying 7 % looser")
             Wz = float(Wz * 1.07)
             continue
         mu = float(max(res.mu_upper_dg, 0.0)) if np.isfinite(res.mu_upper_dg) else float(res.mu_upper)
-        tries.append(WzTry(Wz, mu, float(res.mu_lower), res.controller_order, time.perf_counter() - ti,
-                           len(res.history)))
-        runs.append((plant, res))
-        if out is not None:
-            print(f"[mbi]        mu <= {mu:.4f} (lower {res.mu_lower:.4f})", file=out, flush=True)
+        s.tries.append(WzTry(Wz, mu, float(res.mu_lower), res.controller_order, time.perf_counter() - ti,
+                             len(res.history)))
+        s.runs.append((plant, res))
+        say(f"       mu <= {mu:.4f} (lower {res.mu_lower:.4f})")
         if 1.0 - tol <= mu <= 1.0:
             break
         if mu > 1.0:
             lo = Wz if lo is None else max(lo, Wz)
         else:
             hi = Wz if hi is None else min(hi, Wz)
-        # log-log secant on the last two tries, slope -1 on the first
-        if len(tries) >= 2 and tries[-1].Wz != tries[-2].Wz and tries[-1].mu_upper > 0 and tries[-2].mu_upper > 0:
-            a, b = tries[-2], tries[-1]
-            slope = (np.log(b.mu_upper) - np.log(a.mu_upper)) / (np.log(b.Wz) - np.log(a.Wz))
-            slope = slope if slope < -0.05 else -1.0
-        else:
-            slope = -1.0
-        new = Wz * np.exp((np.log(target) - np.log(max(mu, 1e-12))) / slope)
-        if lo is not None and hi is not None:
-            if not lo < new < hi:
-                new = np.sqrt(lo * hi)
-        elif lo is not None and new <= lo:
-            new = lo * 1.1
-        Wz = float(new)
-    if not runs:
-        raise SolverError(f"identify: every D-K run failed ({len(failed)} W_z values from {failed[0][0]:.4g} to "
-                          f"{failed[-1][0]:.4g}); the last: {failed[-1][1]}")
+        Wz = _next_wz(s.tries, Wz, mu, lo, hi, target)
+    if not s.runs:
+        raise SolverError(f"identify: every D-K run failed ({len(s.failed)} W_z values from {s.failed[0][0]:.4g} "
+                          f"to {s.failed[-1][0]:.4g}); the last: {s.failed[-1][1]}")
+    return s
+
+
+def _best_try(tries) -> int:
+    """The smallest W_z with mu <= 1, else the lowest mu."""
     ok = [i for i, t in enumerate(tries) if t.mu_upper <= 1.0]
-    best = min(ok, key=lambda i: tries[i].Wz) if ok else int(np.argmin([t.mu_upper for t in tries]))
-    plant, res = runs[best]
-    notes = start_notes
-    if failed:
-        notes.append(f"the K step failed at {len(failed)} W_z value(s) ("
-                     + ", ".join(f"{w:.4g}" for w, _ in failed) + "); the search moved on to looser ones")
-    if measured_fit is not None:
-        Gm = np.asarray(measured.response, complex)
-        xc = freqresp(controlled_engineering(plant, res.K), 2 * np.pi * np.asarray(measured.freq_hz, float))[0, 0]
-        rel = float(np.sqrt(np.mean(np.abs(xc - Gm) ** 2 / np.abs(Gm) ** 2)))
-        notes.append(f"against the measured data themselves the controlled model is off by {rel:.3g} "
-                     f"(RMS relative; the fit of the data alone leaves {measured_fit.residual:.3g})")
-        notes.append(f"true system: the measured FRF fitted by a stable model of order {measured_fit.order} "
-                     f"(relative residual {measured_fit.residual:.3g})" +
-                     (f"; {measured_fit.notes[0]}" if measured_fit.notes else ""))
+    return min(ok, key=lambda i: tries[i].Wz) if ok else int(np.argmin([t.mu_upper for t in tries]))
+
+
+def _measured_notes(plant: MBIPlant, res, measured, measured_fit) -> list:
+    """How far the controlled model is from the measured data, and how the data were fitted."""
+    Gm = np.asarray(measured.response, complex)
+    xc = freqresp(controlled_engineering(plant, res.K), 2 * np.pi * np.asarray(measured.freq_hz, float))[0, 0]
+    rel = float(np.sqrt(np.mean(np.abs(xc - Gm) ** 2 / np.abs(Gm) ** 2)))
+    return [(f"against the measured data themselves the controlled model is off by {rel:.3g} "
+             f"(RMS relative; the fit of the data alone leaves {measured_fit.residual:.3g})"),
+            (f"true system: the measured FRF fitted by a stable model of order {measured_fit.order} "
+             f"(relative residual {measured_fit.residual:.3g})"
+             + (f"; {measured_fit.notes[0]}" if measured_fit.notes else ""))]
+
+
+def _search_notes(search: _WzSearch, best: int, tol: float, max_tries: int, time_limit, t0: float) -> list:
+    """A search that stopped outside the accepted window, and the budget used."""
+    tries, notes = search.tries, []
     if not 1.0 - tol <= tries[best].mu_upper <= 1.0:
-        why = (f"the time limit of {time_limit:g} s was spent" if stopped_by_time
+        ok = any(t.mu_upper <= 1.0 for t in tries)
+        why = (f"the time limit of {time_limit:g} s was spent" if search.stopped_by_time
                else f"max_tries={max_tries} was reached")
         notes.append(f"W_z search stopped after {len(tries)} tries ({why}) without mu in [{1 - tol:.3g}, 1]; "
                      f"returning the try with {'the smallest W_z at mu <= 1' if ok else 'the lowest mu (> 1)'}")
     limit = "none" if time_limit is None else f"{time_limit:g} s"
     notes.append(f"budget: max_tries {max_tries}, time_limit {limit}; used {len(tries)} D-K run(s) in "
                  f"{time.perf_counter() - t0:.1f} s")
-    if plant.eps_u or plant.eps_y:
-        notes.append(f"regularised: control penalty {plant.eps_u:.3g} per unit u, sensor noise "
-                     f"{plant.eps_y:.3g} (the thesis plant is singular)")
-    sens, band = identifiable_band(plant, res.K, omega)
+    return notes
+
+
+def _fit_on_identifiable_band(plant: MBIPlant, K, omega, notes: list) -> ImpedanceFit:
+    """The impedance fit of ``K`` on its identifiable band (the whole grid if that band is too thin)."""
+    sens, band = identifiable_band(plant, K, omega)
     if band.sum() < 3:
         notes.append("K has almost no identifiable band (|s K| >= 1 at fewer than 3 frequencies); "
                      "the fit uses the whole grid")
         band = np.ones_like(band)
-    fit = fit_impedance(res.K, omega[band], weight=sens[band])
-    return MBIResult(res.K, tries[best].Wz, tries[best].mu_upper, tries[best].mu_lower, tries, plant, fit,
-                     controlled_engineering(plant, res.K), res, time.perf_counter() - t0, omega, notes, floor,
-                     measured_fit)
+    return fit_impedance(K, omega[band], weight=sens[band])
 
 
 def impedance_response(coeffs: dict, omega) -> np.ndarray:

@@ -6,7 +6,13 @@ import time
 
 
 class ProgressLine:
-    """Callable ``(stage, fraction)``: one updating line on a terminal, a line per stage otherwise."""
+    """Callable ``(stage, fraction)``: one updating line on a terminal, a line per stage otherwise.
+
+    It is also a writable stream (``write``, ``flush``): pass it as the ``out``
+    log of a library call that reports progress too (``identify(..., out=line,
+    progress=line)``), and the log's lines appear below the bar instead of
+    through it.
+    """
 
     def __init__(self, stream=None, enabled: bool = True):
         self.stream = stream or sys.stderr
@@ -14,6 +20,16 @@ class ProgressLine:
         self.tty = hasattr(self.stream, "isatty") and self.stream.isatty()
         self.t0 = time.perf_counter()
         self.last = None
+        self.bar_shown = False      # an unfinished bar is on the terminal's current line
+
+    def write(self, text: str):
+        if self.bar_shown:
+            self.stream.write("\r" + " " * 110 + "\r")
+            self.bar_shown = False
+        self.stream.write(text)
+
+    def flush(self):
+        self.stream.flush()
 
     def __call__(self, stage: str, fraction: float):
         if not self.enabled:
@@ -24,6 +40,7 @@ class ProgressLine:
         line = f"[{bar}] {100 * fraction:3.0f} %  {el:5.1f} s  {stage}"
         if self.tty:
             self.stream.write("\r" + line[:110].ljust(110))
+            self.bar_shown = fraction < 1.0
             if fraction >= 1.0:
                 self.stream.write("\n")
         else:

@@ -14,6 +14,7 @@ from scipy import integrate, linalg, optimize
 
 from mutext.errors import ModelError
 from mutext.rotor import crack as cr
+from mutext.rotor.simulate import simulate_breathing_jeffcott
 
 E = cr.RIG_YOUNGS_MODULUS          # 30 Mpsi [Pa]
 D = cr.RIG_SHAFT_DIAMETER          # 0.625 in [m]
@@ -428,7 +429,7 @@ def _harmonic_balance_mayes(speed, zeta, gravity, dk, n_harm=24):
 
 def test_jeffcott_mayes_matches_harmonic_balance():
     speed = 0.5 * W0
-    res = cr.simulate_breathing_jeffcott(M_DISK, K0, DK, speed, model="mayes", damping_ratio=0.02)
+    res = simulate_breathing_jeffcott(M_DISK, K0, DK, speed, model="mayes", damping_ratio=0.02)
     hb = _harmonic_balance_mayes(speed, 0.02, 9.81, DK)
     for n in (1, 2, 3):
         assert np.allclose(res.harmonic(n), hb[n], rtol=0, atol=1e-5 * np.abs(hb[2]).max()), n
@@ -436,17 +437,17 @@ def test_jeffcott_mayes_matches_harmonic_balance():
 
 def test_breathing_crack_2x_peaks_at_half_critical_speed():
     """Gasch (1993): the weight-dominated breathing crack excites 2X, resonant at w0/2."""
-    amp = {r: cr.simulate_breathing_jeffcott(M_DISK, K0, DK, r * W0, model="mayes").amplitude(2)
+    amp = {r: simulate_breathing_jeffcott(M_DISK, K0, DK, r * W0, model="mayes").amplitude(2)
            for r in (0.4, 0.5, 0.6)}
     assert amp[0.5] > 3 * amp[0.4] and amp[0.5] > 3 * amp[0.6]
-    healthy = cr.simulate_breathing_jeffcott(M_DISK, K0, DK, 0.5 * W0, model="closed")
+    healthy = simulate_breathing_jeffcott(M_DISK, K0, DK, 0.5 * W0, model="closed")
     assert healthy.amplitude(2) < 1e-9 * amp[0.5]
 
 
 def test_open_crack_without_gravity_has_no_2x():
     """An always-open crack is a shaft with constant asymmetric stiffness in the rotating
     frame; unbalance is a constant load in that frame, so the steady response is pure 1X."""
-    res = cr.simulate_breathing_jeffcott(M_DISK, K0, DK, 0.5 * W0, model="open", gravity=0.0,
+    res = simulate_breathing_jeffcott(M_DISK, K0, DK, 0.5 * W0, model="open", gravity=0.0,
                                          eccentricity=1e-4, unbalance_angle=0.4)
     assert res.amplitude(1) > 1e-6
     # what is left is the decayed start transient (exp(-12)), not a 2X response
@@ -458,8 +459,8 @@ def test_breathing_and_open_cracks_differ_in_odd_harmonics():
     """Under gravity an asymmetric (open) shaft responds only at even orders (static sag + 2X);
     a breathing crack also produces 1X and 3X, which is what distinguishes it."""
     kw = dict(speed=0.45 * W0, gravity=9.81)
-    opened = cr.simulate_breathing_jeffcott(M_DISK, K0, DK, model="open", **kw)
-    breath = cr.simulate_breathing_jeffcott(M_DISK, K0, DK, model="mayes", **kw)
+    opened = simulate_breathing_jeffcott(M_DISK, K0, DK, model="open", **kw)
+    breath = simulate_breathing_jeffcott(M_DISK, K0, DK, model="mayes", **kw)
     ref = opened.amplitude(2)
     assert ref > 1e-5
     assert opened.amplitude(1) < 1e-6 * ref and opened.amplitude(3) < 1e-6 * ref
@@ -469,18 +470,18 @@ def test_breathing_and_open_cracks_differ_in_odd_harmonics():
 
 @pytest.mark.slow
 def test_gasch_hinge_2x_peak_at_half_critical_speed():
-    amp = {r: cr.simulate_breathing_jeffcott(M_DISK, K0, DK, r * W0, model="gasch").amplitude(2)
+    amp = {r: simulate_breathing_jeffcott(M_DISK, K0, DK, r * W0, model="gasch").amplitude(2)
            for r in (0.4, 0.5, 0.6)}
     assert amp[0.5] > 3 * amp[0.4] and amp[0.5] > 3 * amp[0.6]
 
 
 def test_jeffcott_input_errors():
     with pytest.raises(ModelError, match="dk < k0"):
-        cr.simulate_breathing_jeffcott(1.0, 1e4, 2e4, 50.0)
+        simulate_breathing_jeffcott(1.0, 1e4, 2e4, 50.0)
     with pytest.raises(ModelError, match="crack model"):
-        cr.simulate_breathing_jeffcott(1.0, 1e4, 1e3, 50.0, model="hinge")
+        simulate_breathing_jeffcott(1.0, 1e4, 1e3, 50.0, model="hinge")
     with pytest.raises(ModelError, match="speed"):
-        cr.simulate_breathing_jeffcott(1.0, 1e4, 1e3, 0.0)
+        simulate_breathing_jeffcott(1.0, 1e4, 1e3, 0.0)
 
 
 def test_ipopt_recovers_depth_from_compliance():

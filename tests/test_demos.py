@@ -29,3 +29,32 @@ def test_two_mass_hinf_json_reports_the_checks(capsys):
     assert d["closed_loop_stable"] is True
     assert len(d["controller_rhp_poles"]) == 2
     assert d["closed_loop_hinf_slycot"] == pytest.approx(d["closed_loop_hinf"], rel=1e-4)
+
+
+class _Terminal:
+    """A stream that says it is a terminal, recording what is written."""
+
+    def __init__(self):
+        self.text = ""
+
+    def isatty(self):
+        return True
+
+    def write(self, s):
+        self.text += s
+
+    def flush(self):
+        pass
+
+
+def test_progress_line_is_also_the_log_stream_below_the_bar():
+    from mutext.progress import ProgressLine
+    term = _Terminal()
+    line = ProgressLine(term)
+    line("W_z try 1/2", 0.25)
+    print("[mbi] try 1: Wz = 0.01", file=line)      # a log line clears the unfinished bar first
+    assert term.text.endswith("\r" + " " * 110 + "\r[mbi] try 1: Wz = 0.01\n")
+    line("done", 1.0)
+    term.text = ""
+    print("after the end", file=line)               # a finished bar stays
+    assert term.text == "after the end\n"

@@ -171,12 +171,17 @@ def test_below_the_floor_mu_exceeds_one():
     pl = mbi_plant(**args, Wz=0.95 * f.value)
     res = dk_iteration(pl.P, pl.structure, 1, 1, max_iter=2, out=None)
     assert res.mu_lower > 1.0
-    buf = io.StringIO()
-    r = identify(**args, Wz=0.5 * f.value, max_tries=1, out=buf, dk_options={"max_iter": 1})
+    buf, calls = io.StringIO(), []
+    r = identify(**args, Wz=0.5 * f.value, max_tries=1, out=buf, dk_options={"max_iter": 1},
+                 progress=lambda stage, frac: calls.append((stage, frac)))
     assert r.tries[0].Wz == pytest.approx(1.1 * r.floor.value)
     assert r.floor.value == pytest.approx(f.value, rel=1e-3)     # same floor on identify's grid
     assert any("below the floor" in n for n in r.notes)
     assert "W_z floor" in buf.getvalue()
+    # the W_z search reports through the callback (the D-K stages inside the try), ending at 1
+    assert calls[0][0].startswith("W_z try 1/1") and calls[-1][1] == 1.0
+    assert any(stage.startswith("K-step") and "W_z try 1/1" in stage for stage, _ in calls)
+    assert all(0.0 <= frac <= 1.0 for _, frac in calls)
 
 
 @pytest.mark.slow

@@ -169,12 +169,17 @@ def test_fit_from_frf_files_in_other_units(rotor, tmp_path):
     assert res.units["exciter12.ki"] == "N/A"
 
 
-def test_verbose_prints_every_iteration(rotor, capsys):
+def test_verbose_prints_and_progress_reports_every_iteration(rotor, capsys):
     frfs = rig_frfs(rotor, {"rho": 8100.0}, channels=((13, "x13"),))
-    res = tune(rotor, frfs, ["rho"], max_points=40, verbose=True)
+    calls = []
+    res = tune(rotor, frfs, ["rho"], max_points=40, verbose=True,
+               progress=lambda stage, frac: calls.append((stage, frac)))
     out = capsys.readouterr().out
     lines = [ln for ln in out.splitlines() if ln.strip().startswith("iter")]
     assert len(lines) == res.iterations + 1 == len(res.history)
+    # the same lines through the progress callback, then the end at fraction 1
+    assert [stage for stage, _ in calls[:-1]] == [f"tune: {ln.strip()}" for ln in lines]
+    assert calls[-1][1] == 1.0 and all(0.0 <= frac < 1.0 for _, frac in calls[:-1])
     assert "objective" in lines[0] and "rho=" in lines[0]
     assert res.history[-1] < 1e-10 * res.history[0]
     assert "rho" in str(res) and "IPOPT" in str(res)

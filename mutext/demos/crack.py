@@ -54,11 +54,11 @@ def _first_mode_band(f1, f):
     return sel if sel.sum() >= 3 else np.abs(f - f1) <= np.sort(np.abs(f - f1))[2]
 
 
-def _identify(measured, E, out):
+def _identify(measured, E, out, progress=None):
     from ..mbi import identify
     return identify(measured, E, excitation=ex.EXCITATION, measurement=ex.MEASUREMENT,
                     control_input=ex.CONTROL_INPUT, control_output=ex.CONTROL_OUTPUT, Ww=ex.THESIS["Ww"],
-                    out=out)
+                    out=out, progress=progress)
 
 
 def _k_peaks(K, f):
@@ -68,8 +68,11 @@ def _k_peaks(K, f):
 
 
 def solve(depth: float = 0.4, law: str = "mayes", noise: float = 0.001, seed: int = 0,
-          cutoff_hz: float = 250.0, thesis_tables: bool = False, out=sys.stderr) -> dict:
-    """Everything the demo reports, as a dict (SI; frequencies in Hz)."""
+          cutoff_hz: float = 250.0, thesis_tables: bool = False, out=sys.stderr, progress=None) -> dict:
+    """Everything the demo reports, as a dict (SI; frequencies in Hz).
+
+    ``out`` gets the log, ``progress(stage, fraction)`` the W_z search's progress
+    (:func:`mutext.mbi.identify`)."""
     from ..diagnose import sideband_evidence
     from ..errors import ModelError
     from ..lti import freqresp
@@ -108,7 +111,7 @@ def solve(depth: float = 0.4, law: str = "mayes", noise: float = 0.001, seed: in
     say(f"engineering model: healthy rotor, modal truncation at {cutoff_hz:g} Hz -> {red.order} states "
         f"(error {red_err:.2g} of the peak, every channel)")
 
-    res = _identify(measured, E, out)
+    res = _identify(measured, E, out, progress)
     say(f"identified: mu {res.mu_upper:.4f} at W_z {res.Wz:.3g} m, K of order {res.K.nstates}")
 
     # what K means: its dynamic stiffness near the first mode against the exact requirement
@@ -154,12 +157,12 @@ def solve(depth: float = 0.4, law: str = "mayes", noise: float = 0.001, seed: in
     result.update(engineering_system=E, first_mode_mask=band1)
     if thesis_tables:
         say("thesis data path: cracked station table (density, disk mass) as the true system")
-        result["thesis_tables"] = thesis_tables_path(result, out=out)
+        result["thesis_tables"] = thesis_tables_path(result, out=out, progress=progress)
     result["seconds"] = time.perf_counter() - t0
     return result
 
 
-def thesis_tables_path(result, *, out=None) -> dict:
+def thesis_tables_path(result, *, out=None, progress=None) -> dict:
     """The thesis's own data path: its cracked station table (density and disk mass tuned by hand,
     no crack element) as the true system, against the same engineering model as ``result``
     (a dict of :func:`solve`), with the same noise."""
@@ -172,7 +175,7 @@ def thesis_tables_path(result, *, out=None) -> dict:
     tm = measure(table.state_space(inputs=[ex.EXCITATION], outputs=[ex.MEASUREMENT]), ex.EXCITATION,
                  ex.MEASUREMENT, f, noise=rig["noise"], rng=rig["seed"])
     tm.input_name, tm.output_name = ex.EXCITATION, ex.MEASUREMENT
-    rt = _identify(tm, result["engineering_system"], out)
+    rt = _identify(tm, result["engineering_system"], out, progress)
     Kt = freqresp(rt.K, w)[0, 0]
     return {"mu": rt.mu_upper, "Wz": rt.Wz, "K_order": int(rt.K.nstates), "K_reading": rt.fit.description,
             "K_peaks_hz": _k_peaks(rt.K, f), "K_at_first_mode": -float(np.median(Kt[result["first_mode_mask"]].real)),
@@ -188,7 +191,10 @@ JSON_KEYS = ("mu", "mu_lower", "Wz", "K_order", "equivalent_stiffness_loss", "id
 
 
 def run(args) -> int:
-    out = solve(args.depth, args.law, args.noise, args.seed, args.cutoff, args.thesis_tables)
+    from ..progress import ProgressLine
+    prog = ProgressLine()        # the log and the W_z search's bar, both on stderr
+    out = solve(args.depth, args.law, args.noise, args.seed, args.cutoff, args.thesis_tables, out=prog,
+                progress=prog)
     if args.json:
         from ..jsonio import print_json
         d = {k: out[k] for k in JSON_KEYS}

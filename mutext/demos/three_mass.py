@@ -40,7 +40,7 @@ def measured_sweep(trial: str, noise: float, path, rng=0):
     return read_frf(write_frf(path, frf, output_unit="mm"))
 
 
-def solve(trial: str = "1a", out=sys.stderr, measured=None):
+def solve(trial: str = "1a", out=sys.stderr, measured=None, progress=None):
     """Run one trial; everything the demo, the book and the tests report, as a dict.
 
     ``measured``: a :class:`mutext.rig.FRF` (f1 -> x1) that replaces the trial's
@@ -50,7 +50,7 @@ def solve(trial: str = "1a", out=sys.stderr, measured=None):
     args = three_mass.mbi_arguments(tr)
     if measured is not None:
         args["true"] = measured
-    res = identify(**args, Wz=None if measured is not None else tr.Wz, out=out)
+    res = identify(**args, Wz=None if measured is not None else tr.Wz, out=out, progress=progress)
     band = res.fit.omega
     return {
         "trial": tr.name,
@@ -96,9 +96,9 @@ def figure(r, samples: int = 8):
 
 
 def run(args) -> int:
-    out = None if (args.quiet or args.json) else sys.stderr
-    if args.json and not args.quiet:
-        out = sys.stderr
+    from ..progress import ProgressLine
+    prog = None if args.quiet else ProgressLine()
+    out = prog              # the search's log, below the progress bar (on stderr)
     tr = three_mass.TRIALS[args.trial]
     measured = None
     if args.frf:
@@ -128,7 +128,7 @@ def run(args) -> int:
                   f"k3={e.k3} N/m; true m3={t.m3}, c3={t.c3}, k3={t.k3} "
                   + ("(measured sweep)" if args.measured is not None else f"(+/-{tr.uncertainty:.0%})"))
         print("D-K iteration and W_z search (progress on stderr) ...", flush=True)
-    r = solve(args.trial, out=out, measured=measured)
+    r = solve(args.trial, out=out, measured=measured, progress=prog)
     if args.frf:                # the user's own data: no known difference to compare K with
         r.update({"Du": None, "K_rel_error": None, "K_rel_error_unweighted": None, "Du_spread": None})
     if args.plots:

@@ -7,7 +7,7 @@ import numpy as np
 
 from ..errors import ModelError
 from ..response import FRF
-from ..rotor.tuning import _Inputs, _resolve_channel
+from ..rotor.frf_channels import _Inputs, _resolve_channel
 
 
 @dataclass

@@ -168,7 +168,8 @@ def diagnose(model, frfs, validate=None, *, alpha: float = 0.01, refit: int = 3,
         tell("model-based identification at the finding (D-K iteration)", 0.97)
         try:
             result.mbi = mbi_reading(model_text, path, verdict, chans[0].frf, chans[0].in_name,
-                                     chans[0].out_name)
+                                     chans[0].out_name, progress=lambda stage, frac: tell(
+                                         f"model-based identification: {stage}", 0.97 + 0.02 * frac))
         except ModelError as exc:
             result.mbi = {"location": None, "reading": f"not run: {exc}", "agrees": None}
         result.seconds = time.perf_counter() - t0
@@ -325,9 +326,11 @@ def _refit_best(findings, refit, model_text, path, eng, fit, s2, N, rss0, thresh
         if h.gain is not None or h.parameter is None:
             continue
         n_ref += 1
-        tell(f"refitting {f.kind} at {f.station} on the extended model", 0.7 + 0.2 * n_ref / max(refit, 1))
+        stage, at = f"refitting {f.kind} at {f.station} on the extended model", 0.7 + 0.2 * n_ref / max(refit, 1)
+        tell(stage, at)
         try:
-            _refit(f, model_text, path, eng, fit, s2, N, rss0, threshold)
+            _refit(f, model_text, path, eng, fit, s2, N, rss0, threshold,
+                   progress=lambda line, _, stage=stage, at=at: tell(f"{stage}: {line}", at))
         except Exception as exc:   # the screen's value stands; say why
             notes.append(f"refit of {f.kind} at station {f.station} failed ({exc}); the screen's value is shown")
     return notes

@@ -120,7 +120,7 @@ def write_model(result: Diagnosis, out_dir) -> str | None:
 
 
 def mbi_reading(model_text: str, path: str, finding: Finding, frf: FRF, excitation: str,
-                measurement: str) -> dict:
+                measurement: str, progress=None) -> dict:
     r"""The thesis's route to the same finding: a mu-controller at the finding's mass absorbs the effect.
 
     The engineering model gets a force input and a displacement output at the
@@ -135,6 +135,7 @@ def mbi_reading(model_text: str, path: str, finding: Finding, frf: FRF, excitati
 
     Only lumped chains and findings at one mass (a mass, a grounded spring or
     damper) have a single controller location; other findings raise ModelError.
+    ``progress(stage, fraction)`` is passed to :func:`mutext.mbi.identify`.
     """
     import tomllib
     from ..mbi import identify       # D-K iteration: imported only when asked for (--mbi)
@@ -154,7 +155,7 @@ def mbi_reading(model_text: str, path: str, finding: Finding, frf: FRF, excitati
     E = ext.state_space(inputs=[excitation, "u_mbi"], outputs=[measurement, "y_mbi"])
     t0 = time.perf_counter()
     res = identify(frf, E, excitation=excitation, measurement=measurement, control_input="u_mbi",
-                   control_output="y_mbi", out=None)
+                   control_output="y_mbi", out=None, progress=progress)
     fit = res.fit
     coef = {"mass": ("dm", 0), "damping": ("dc", 1), "stiffness": ("dk", 2)}[finding.kind]
     v = float(getattr(fit, coef[0]))
@@ -167,8 +168,10 @@ def mbi_reading(model_text: str, path: str, finding: Finding, frf: FRF, excitati
             "agrees": bool(abs(v - finding.value) <= 3 * comb), "seconds": time.perf_counter() - t0}
 
 
-def _refit(f: Finding, model_text, path, eng, fit: _Data, s2, N, rss0, threshold):
-    """Fit the size again with tune() on the extended model; update the finding in place."""
+def _refit(f: Finding, model_text, path, eng, fit: _Data, s2, N, rss0, threshold, progress=None):
+    """Fit the size again with tune() on the extended model; update the finding in place.
+
+    ``progress(stage, fraction)`` is passed to :func:`mutext.rotor.tuning.tune`."""
     h = f.hypothesis
     start = f.value if not h.added else max(f.value, 1e-3 * h.scale)
     trial = Finding(**{**f.__dict__, "value": start,
@@ -181,7 +184,7 @@ def _refit(f: Finding, model_text, path, eng, fit: _Data, s2, N, rss0, threshold
     frfs = [replace(c.frf, freq_hz=fs, response=m, metadata=dict(c.frf.metadata))
             for c, fs, m in zip(fit.chans, fit.freq_hz, fit.meas)]
     x0 = min(max(float(ext.values()[ext.parameter_names.index(name)]), lo), hi)
-    res = tune(ext, frfs, [name], bounds={name: (lo, hi)}, start={name: x0}, max_iter=60)
+    res = tune(ext, frfs, [name], bounds={name: (lo, hi)}, start={name: x0}, max_iter=60, progress=progress)
     v = res.values[name]
     rms = (res.residual_rms_db / DB_PER_NEPER) ** 2 + math.radians(res.residual_rms_deg) ** 2
     rss = res.n_points * rms

@@ -8,7 +8,13 @@ table
     Station tables in the thesis appendix format.
 elements
     Timoshenko shaft, disk, bearing and exciter elements (and lumped masses,
-    springs, dampers), each matrix a CasADi expression of named parameters.
+    springs, dampers), each matrix a CasADi expression of named parameters;
+    gathers one module per part: ``element`` (parameters, DOF layout, ports,
+    the :class:`Element` interface), ``shaft_element``, ``disk_element``,
+    ``bearing_element``, ``exciter_element``, ``lumped_elements``.
+crack
+    Open-crack compliance (fracture mechanics), breathing laws and the
+    :class:`~mutext.rotor.crack.Crack` element.
 assembly
     :class:`Structure` / :class:`Rotor`: assembled ``M(p), C(p), K(p), G(p)``
     as ``casadi.Function`` objects, numeric matrices, the crack hook.
@@ -16,17 +22,24 @@ model
     TOML model files for rotors and lumped chains.
 analysis
     Natural frequencies, mode shapes, whirl, Campbell data, FRFs, state space.
+analytic
+    Closed-form beam frequencies (references for the finite elements).
 reduction
     Modal truncation with static correction and balanced truncation, with
     the measured error (H-infinity norm, band error) and the a-priori bound.
 periodic
     A breathing crack at speed: the time-periodic rotor, harmonic transfer
     functions, the analyzer's FRF and a brute-force time integration.
+simulate
+    Time simulation of a Jeffcott rotor with a breathing crack.
+frf_channels
+    Measured FRFs as channels of a model (input column, output DOF, speed).
+sensitivity
+    FRFs and their exact parameter derivatives (adjoint, Daleckii-Krein).
 tuning
-    Fitting parameters to measured FRFs (IPOPT through CasADi, exact
-    sensitivities, uncertainties).
-demo
-    ``mutext demo rotor``.
+    Fitting parameters to measured FRFs: :func:`tune` chains the objective
+    (``_tune_objective``: unknowns, channels, log residuals) and the IPOPT
+    driver (``_ipopt``); uncertainties.
 
 Example
 -------
