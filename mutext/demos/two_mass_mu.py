@@ -60,22 +60,6 @@ def check_controller(K, x_max: float, rel: float = 0.02) -> dict:
     }
 
 
-class _TableBelowProgress:
-    """A stream for the iteration table that first clears the progress line on a terminal."""
-
-    def __init__(self, progress, stream=sys.stderr):
-        self.progress, self.stream, self.fresh = progress, stream, True
-
-    def write(self, text):
-        if self.fresh and self.progress.tty and self.progress.enabled:
-            self.stream.write("\r" + " " * 110 + "\r")
-        self.stream.write(text)
-        self.fresh = text.endswith("\n")
-
-    def flush(self):
-        self.stream.flush()
-
-
 def solve(x_max: float = 0.035, max_iter: int = 6, out=sys.stderr, progress=None) -> dict:
     """Run the D-K iteration and the checks; everything the demo and the tests report.
 
@@ -123,7 +107,7 @@ def run(args) -> int:
           "D-K iteration:", file=sys.stderr, flush=True)
     from ..progress import ProgressLine
     prog = ProgressLine()
-    out = solve(args.xmax, args.max_iter, out=_TableBelowProgress(prog), progress=prog)
+    out = solve(args.xmax, args.max_iter, out=prog, progress=prog)
     if args.json:
         from ..jsonio import print_json
         print_json({k: v for k, v in out.items() if k != "result"})
