@@ -1,0 +1,375 @@
+r"""Upper bound by D-G scalings without an SDP: quasi-Newton descent ([YND]_, [LO]_).
+
+BFGS with the weak Wolfe line search on :math:`\log\lambda_{\max}` of the
+congruent form, in coordinates that carry over from one frequency to the next
+(``mu_upper(method="fast")`` and the warm-started sweep of :func:`mu_sweep`).
+"""
+from __future__ import annotations
+
+import numpy as np
+
+from ._certificate import MuUpper, _d_from_matrices, _diag_result
+from ._osborne import _osborne
+from ._structure import BlockStructure, _norm2
+
+
+class _DGParams:
+    r"""Coordinates of the scalings of the fast D-G bound for one structure.
+
+    Block ``k`` has a factor :math:`L_k` with :math:`D_k = L_kL_k^H`: a positive
+    scalar :math:`e^{x}` on full and ``1 x 1`` blocks, a lower-triangular
+    matrix (log diagonal, complex entries below) on repeated scalars.  A real
+    block also has a Hermitian :math:`\hat G_k` (each real coordinate of it the
+    ``sinh`` of a coordinate here, so that the flat approach of the bound to its
+    infimum as :math:`G\to\infty`, common for nearly real ``M``, takes few
+    steps) and :math:`G_k = \beta_0 L_k\hat G_kL_k^H`, so that in the congruent form
+
+    .. math::
+        H = A^HA + j\beta_0(\hat GA - A^H\hat G), \qquad A = L_\ell^H M L_r^{-H},
+
+    :math:`\hat G` is dimensionless and independent of :math:`D` (the
+    :math:`D,\,G/\beta` form of Young, Newlin and Doyle [YND]_); its value
+    carries over from one frequency to the next.  The first coordinate of the
+    last block is fixed to 0 (the bound is invariant to scaling all of D).
+    """
+
+    def __init__(self, S: BlockStructure, use_g: bool):
+        self.S = S
+        self.use_g = use_g
+        self.diag = S.diagonal_scalings
+        self.lslots, self.gslots = [], []
+        n = 0
+        for b in S.blocks:
+            k = 1 if b.diagonal_scaling else b.rows * b.rows
+            self.lslots.append(slice(n, n + k))
+            n += k
+        for b in S.blocks:
+            if use_g and b.kind == "real":
+                k = b.rows * b.rows
+                self.gslots.append(slice(n, n + k))
+                n += k
+            else:
+                self.gslots.append(None)
+        self.size = n
+        self.fixed = self.lslots[-1].start
+        self.free = np.delete(np.arange(n), self.fixed)
+        if self.diag:
+            # coordinates are [log d per block, G-hat per real block]
+            self.m = len(S)
+            self.real_idx = np.array([k for k, g in enumerate(self.gslots) if g is not None], int)
+            self.nreal = self.real_idx.size
+            self.grow = np.array([S.row_slices[k].start for k in self.real_idx], int)
+            self.gcol = np.array([S.col_slices[k].start for k in self.real_idx], int)
+            self.El = np.eye(self.m)[S.col_block]
+            self.Er = np.eye(self.m)[S.row_block]
+
+    # -- small matrices from coordinates -------------------------------------
+    @staticmethod
+    def _lower(p, n):
+        """Lower-triangular factor: exp(p) on the diagonal, complex entries below."""
+        L = np.zeros((n, n), complex)
+        L[np.diag_indices(n)] = np.exp(p[:n])
+        il = np.tril_indices(n, -1)
+        m = len(il[0])
+        L[il] = p[n:n + m] + 1j * p[n + m:n + 2 * m]
+        return L
+
+    @staticmethod
+    def _herm(p, n):
+        G = np.zeros((n, n), complex)
+        G[np.diag_indices(n)] = p[:n]
+        iu = np.triu_indices(n, 1)
+        m = len(iu[0])
+        G[iu] = p[n:n + m] + 1j * p[n + m:n + 2 * m]
+        G[(iu[1], iu[0])] = np.conj(G[iu])
+        return G
+
+    def initial(self, d) -> np.ndarray:
+        """Coordinates for diagonal scalings ``d`` (one per block, L = d) and G = 0."""
+        x = np.zeros(self.size)
+        for b, sl, dk in zip(self.S.blocks, self.lslots, d):
+            x[sl.start:sl.start + (1 if b.diagonal_scaling else b.rows)] = np.log(dk)
+        return x - x[self.fixed] * self._log_mask()
+
+    def _log_mask(self):
+        m = np.zeros(self.size)
+        for b, sl in zip(self.S.blocks, self.lslots):
+            m[sl.start:sl.start + (1 if b.diagonal_scaling else b.rows)] = 1.0
+        return m
+
+    # -- the bound and its gradient -------------------------------------------
+    def value_grad(self, x, M, beta0, grad: bool = True):
+        r"""(lambda, grad log lambda) with :math:`\lambda = \lambda_{\max}(H)` (the squared bound)."""
+        S = self.S
+        if self.diag:
+            # one scaling per block (coordinates 0..m-1), G-hat on 1 x 1 real blocks after them
+            m = self.m
+            e = np.exp(x[:m])
+            A = e[S.col_block][:, None] * M / e[S.row_block][None, :]
+            H = A.conj().T @ A
+            if self.nreal:
+                gs = np.sinh(x[m:])
+                # G A: G maps column gcol of A (z of the real block) to row grow (its w)
+                GA = np.zeros((S.nrows, S.nrows), complex)
+                GA[self.grow] = (beta0 * gs)[:, None] * A[self.gcol]
+                H = H + 1j * (GA - GA.conj().T)
+            ev, V = np.linalg.eigh(H)
+            lam = float(ev[-1])
+            if not grad:
+                return lam, None
+            v = V[:, -1]
+            a = A @ v
+            g = np.empty(self.size)
+            g[:m] = 2.0 * ((a.real ** 2 + a.imag ** 2) @ self.El - lam * ((v.real ** 2 + v.imag ** 2) @ self.Er))
+            if self.nreal:
+                im = (np.conj(v[self.grow]) * a[self.gcol]).imag
+                g[self.real_idx] -= 4.0 * beta0 * gs * im
+                g[m:] = -2.0 * beta0 * im * np.cosh(x[m:])
+            return lam, g / max(lam, 1e-300)
+        # general structure (repeated scalars): block-diagonal factors
+        Lc = np.zeros((S.ncols, S.ncols), complex)
+        Lri = np.zeros((S.nrows, S.nrows), complex)
+        Gh = np.zeros((S.nrows, S.ncols), complex) if self.use_g else None
+        Ls, Ghs = [], []
+        for b, rs, cs, sl, gs in zip(S.blocks, S.row_slices, S.col_slices, self.lslots, self.gslots):
+            if b.diagonal_scaling:
+                l = np.exp(x[sl.start])
+                Lc[cs, cs] = l * np.eye(b.cols)
+                Lri[rs, rs] = np.eye(b.rows) / l
+                Ls.append(l)
+            else:
+                L = self._lower(x[sl], b.rows)
+                Lc[cs, cs] = L
+                Lri[rs, rs] = np.linalg.inv(L)
+                Ls.append(L)
+            Gk = None
+            if gs is not None:
+                Gk = self._herm(np.sinh(x[gs]), b.rows)
+                Gh[rs, cs] = beta0 * Gk
+            Ghs.append(Gk)
+        A = Lc.conj().T @ M @ Lri.conj().T
+        H = A.conj().T @ A
+        if Gh is not None:
+            GA = Gh @ A
+            H = H + 1j * (GA - GA.conj().T)
+        ev, V = np.linalg.eigh(H)
+        lam = float(ev[-1])
+        if not grad:
+            return lam, None
+        v = V[:, -1]
+        a = A @ v
+        u = Lri.conj().T @ v
+        z = M @ u
+        g = np.zeros(self.size)
+        for b, rs, cs, sl, gs, L, Gk in zip(S.blocks, S.row_slices, S.col_slices, self.lslots, self.gslots,
+                                             Ls, Ghs):
+            if b.diagonal_scaling:
+                gl = 2.0 * (np.vdot(a[cs], a[cs]).real - lam * np.vdot(v[rs], v[rs]).real)
+                if Gk is not None:
+                    gl -= 4.0 * beta0 * Gk[0, 0].real * np.imag(np.conj(v[rs][0]) * a[cs][0])
+                g[sl.start] = gl
+            else:
+                n = b.rows
+                zk, ak, uk, vk = z[cs], a[cs], u[rs], v[rs]
+                gL = 2.0 * (np.outer(zk, ak.conj()) - lam * np.outer(uk, vk.conj()))
+                if Gk is not None:
+                    gL = gL + 2.0 * beta0 * 1j * (np.outer(zk, vk.conj()) - np.outer(uk, ak.conj())) @ Gk
+                il = np.tril_indices(n, -1)
+                m = len(il[0])
+                p = g[sl]
+                p[:n] = np.real(np.diag(gL)) * np.real(np.diag(L))
+                p[n:n + m] = gL[il].real
+                p[n + m:] = gL[il].imag
+                g[sl] = p
+            if Gk is not None:
+                n = b.rows
+                K = beta0 * 1j * (np.outer(a[cs], v[rs].conj()) - np.outer(v[rs], a[cs].conj()))
+                iu = np.triu_indices(n, 1)
+                m = len(iu[0])
+                p = np.empty(n + 2 * m)
+                p[:n] = np.real(np.diag(K))
+                p[n:n + m] = 2.0 * K[iu].real
+                p[n + m:] = 2.0 * K[iu].imag
+                g[gs] = p * np.cosh(x[gs])
+        return lam, g / max(lam, 1e-300)
+
+    def scalings(self, x, beta0):
+        """(Dl, Dr, G) of the LMI form from coordinates."""
+        S = self.S
+        if self.diag:
+            d2 = np.exp(2.0 * x[:self.m])
+            G = None
+            if self.use_g:
+                G = np.zeros((S.nrows, S.ncols), complex)
+                G[self.grow, self.gcol] = beta0 * d2[self.real_idx] * np.sinh(x[self.m:])
+            return np.diag(d2[S.col_block]).astype(complex), np.diag(d2[S.row_block]).astype(complex), G
+        Dl = np.zeros((S.ncols, S.ncols), complex)
+        Dr = np.zeros((S.nrows, S.nrows), complex)
+        G = np.zeros((S.nrows, S.ncols), complex) if self.use_g else None
+        for b, rs, cs, sl, gs in zip(S.blocks, S.row_slices, S.col_slices, self.lslots, self.gslots):
+            if b.diagonal_scaling:
+                L = np.exp(x[sl.start]) * np.eye(b.rows)
+                Dl[cs, cs] = np.exp(2 * x[sl.start]) * np.eye(b.cols)
+                Dr[rs, rs] = np.exp(2 * x[sl.start]) * np.eye(b.rows)
+            else:
+                L = self._lower(x[sl], b.rows)
+                Dl[cs, cs] = Dr[rs, rs] = L @ L.conj().T
+            if gs is not None:
+                G[rs, cs] = beta0 * L @ self._herm(np.sinh(x[gs]), b.rows) @ L.conj().T
+        return Dl, Dr, G
+
+
+def _bfgs(fun, x0, B0=None, max_iter: int = 100, ftol: float = 1e-10, max_step: float = 1.0,
+          max_eval: int = 400):
+    r"""Minimise a (possibly nonsmooth at optimum) function by BFGS with a weak Wolfe line search.
+
+    The line search of Lewis and Overton [LO]_ (bisection/doubling on the
+    Armijo and weak curvature conditions), which keeps BFGS working on max
+    eigenvalue functions.  Stops when an iteration lowers ``f`` by less than
+    ``ftol`` (absolute: ``f`` is a logarithm) twice in a row or the line search fails.
+    ``max_eval`` bounds the function evaluations (the result is then the best
+    point found, still a valid bound).  Returns (f, x, inverse Hessian
+    approximation, evaluations).
+    """
+    x = x0.copy()
+    f, g = fun(x)
+    nev = 1
+    n = x.size
+    B = np.eye(n) if B0 is None else B0.copy()
+    reset = B0 is None
+    small = 0
+    for _ in range(max_iter):
+        if nev >= max_eval:
+            break
+        p = -B @ g
+        gp = float(g @ p)
+        if not gp < 0:
+            B = np.eye(n)
+            p = -g
+            gp = float(g @ p)
+            if not gp < 0:
+                break
+        # at most a factor e^max_step in any scaling per step (a stale or nearly
+        # singular Hessian approximation points far out along flat directions)
+        big = np.abs(p).max()
+        t = min(1.0, max_step / big) if big > 0 else 1.0
+        lo, hi = 0.0, np.inf
+        ok = False
+        for _ls in range(30):
+            xt = x + t * p
+            ft, gt = fun(xt)
+            nev += 1
+            if not ft <= f + 1e-4 * t * gp:
+                hi = t
+            elif float(gt @ p) < 0.9 * gp:
+                lo = t
+            else:
+                ok = True
+                break
+            t = 0.5 * (lo + hi) if np.isfinite(hi) else 2.0 * lo
+        if not ok:
+            if ft < f:          # a decrease without the curvature condition: keep it
+                x, f = xt, ft
+                g = fun(x)[1]
+                nev += 1
+            if reset:
+                break
+            # a stale Hessian approximation (a warm start from another matrix): restart once
+            B = np.eye(n)
+            reset = True
+            continue
+        s, y = t * p, gt - g
+        drop = f - ft
+        x, f, g = xt, ft, gt
+        sy = float(s @ y)
+        if sy > 1e-14 * float(s @ s):
+            By = B @ y
+            rho = 1.0 / sy
+            B = B + ((sy + y @ By) * rho * rho) * (s[:, None] * s) - rho * (By[:, None] * s + s[:, None] * By)
+        small = small + 1 if drop < ftol else 0
+        if small >= 2:
+            break
+    return f, x, B, nev
+
+
+#: restarts of the descent of ``mu_upper(method="fast")``
+_FAST_RESTARTS = 6
+#: largest |G-hat| entry kept in a warm start of the fast D-G bound
+_G_CLIP = 8.0
+
+
+def _upper_fast(M, S: BlockStructure, params: _DGParams, x0=None, B0=None, ftol: float = 1e-10,
+                max_eval: int = 400):
+    """Fast D (or D-G) bound at one matrix, from coordinates ``x0`` (None: Osborne balancing).
+
+    Returns (MuUpper, x, inverse Hessian) with the value recomputed from the
+    scalings' coordinates (the exact largest eigenvalue of the congruent form).
+    """
+    if x0 is None:
+        x0 = params.initial(np.exp(_osborne(M, S)))
+    else:
+        # a warm start: G-hat near a previous frequency's, but not the large values
+        # of a frequency where the infimum is approached as G -> infinity (a flat
+        # region from which the descent at the next frequency stalls)
+        x0 = x0.copy()
+        for gs in params.gslots:
+            if gs is not None:
+                x0[gs] = np.clip(x0[gs], -_G_CLIP, _G_CLIP)
+    beta0 = np.sqrt(max(params.value_grad(x0, M, 1.0, grad=False)[0], 0.0))
+    if params.use_g and beta0 == 0:
+        beta0 = 1.0
+    # the first G-free sigma_max: with a warm start G carries over (it is scaled by beta0)
+    free = params.free
+
+    def fun(y):
+        x = x0.copy()
+        x[free] = y
+        if np.abs(y).max(initial=0.0) > 200.0:
+            return np.inf, np.zeros(free.size)     # a line-search trial far out: reject it
+        with np.errstate(over="ignore", invalid="ignore"):
+            try:
+                lam, g = params.value_grad(x, M, beta0)
+            except np.linalg.LinAlgError:
+                return np.inf, np.zeros(free.size)
+        if not np.isfinite(lam):
+            return np.inf, np.zeros(free.size)
+        if not lam > 0:
+            return -np.inf, np.zeros(free.size)
+        return np.log(lam), g[free]
+    _, y, B, nev = _bfgs(fun, x0[free], B0, ftol=ftol, max_eval=max_eval)
+    x = x0.copy()
+    x[free] = y
+    lam, _ = params.value_grad(x, M, beta0, grad=False)
+    Dl, Dr, G = params.scalings(x, beta0)
+    tag = "fast-dg" if params.use_g else "fast-d"
+    return (MuUpper(float(np.sqrt(max(lam, 0.0))), tag, d=_d_from_matrices(S, Dr), Dl=Dl, Dr=Dr, G=G,
+                    iterations=nev), x, B)
+
+
+def _fast_at(M, S: BlockStructure, params: _DGParams, x0=None, B0=None, ftol: float = 1e-10,
+             max_eval: int = 400):
+    """:func:`_upper_fast` with the shortcuts of :func:`mu_upper` (one full block, ``M = 0``,
+    extreme norms); returns (MuUpper, coordinates or None, inverse Hessian or None)."""
+    nrm = _norm2(M)
+    if nrm == 0 or (len(S) == 1 and S.blocks[0].kind == "full"):
+        return _diag_result(M, S, np.ones(len(S)), "sigma"), None, None
+    if not 1e-100 <= nrm <= 1e100:
+        up, x, B = _upper_fast(M / nrm, S, params, x0, B0, ftol, max_eval)
+        return MuUpper(float(up.value * nrm), up.method, d=up.d, Dl=up.Dl, Dr=up.Dr,
+                       G=None if up.G is None else up.G * nrm, iterations=up.iterations), x, B
+    return _upper_fast(M, S, params, x0, B0, ftol, max_eval)
+
+
+def _fast_polish(M, S: BlockStructure, params: _DGParams, x0=None):
+    """The fast bound to full accuracy: long descents, restarted from the point reached
+    (BFGS can stall at a kink of lambda_max, e.g. with repeated real scalars, and a
+    fresh Hessian approximation often continues).  Returns (MuUpper, coordinates)."""
+    up, x, _ = _fast_at(M, S, params, x0, None, ftol=1e-12, max_eval=400)
+    for _ in range(_FAST_RESTARTS):
+        if x is None:
+            break
+        up2, x2, _ = _fast_at(M, S, params, x, None, ftol=1e-12, max_eval=400)
+        if not up2.value < up.value * (1 - 1e-10):
+            break
+        up, x = up2, x2
+    return up, x

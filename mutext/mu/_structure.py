@@ -1,0 +1,268 @@
+r"""Block structures of the perturbation :math:`\Delta` and the checks of ``M`` against them."""
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Sequence
+
+import numpy as np
+
+from ..errors import ModelError
+
+_KINDS = ("full", "scalar", "real")
+
+
+@dataclass(frozen=True)
+class Block:
+    """One block of the perturbation :math:`\\Delta`.
+
+    Parameters
+    ----------
+    kind : {"full", "scalar", "real"}
+        Full complex matrix, repeated complex scalar or repeated real scalar.
+    rows, cols : int
+        Size of the block of ``Delta`` (``rows`` inputs of ``M`` driven by the
+        block, ``cols`` outputs of ``M`` feeding it).  Scalar blocks are square.
+    name : str
+    """
+    kind: str
+    rows: int
+    cols: int
+    name: str = ""
+
+    def __post_init__(self):
+        if self.kind not in _KINDS:
+            raise ModelError(f"block kind must be one of {_KINDS}, got {self.kind!r}")
+        for what, v in (("rows", self.rows), ("cols", self.cols)):
+            if isinstance(v, bool) or not isinstance(v, (int, np.integer)) or v < 1:
+                raise ModelError(f"block {self.name or self.kind}: {what} must be a positive integer, got {v!r}")
+        if self.kind != "full" and self.rows != self.cols:
+            raise ModelError(f"a repeated scalar block ({self.kind}) must be square, got {self.rows}x{self.cols}")
+
+    @classmethod
+    def full(cls, rows: int, cols: int | None = None, name: str = "") -> "Block":
+        """A full complex ``rows x cols`` block (``cols`` defaults to ``rows``)."""
+        return cls("full", rows, rows if cols is None else cols, name)
+
+    @classmethod
+    def scalar(cls, n: int = 1, name: str = "") -> "Block":
+        """A repeated complex scalar :math:`\\delta I_n`."""
+        return cls("scalar", n, n, name)
+
+    @classmethod
+    def real(cls, n: int = 1, name: str = "") -> "Block":
+        """A repeated real scalar :math:`\\delta I_n`."""
+        return cls("real", n, n, name)
+
+    @property
+    def diagonal_scaling(self) -> bool:
+        """True if the optimal D for this block is a scalar times identity."""
+        return self.kind == "full" or self.rows == 1
+
+
+class BlockStructure:
+    r"""Block-diagonal structure :math:`\boldsymbol\Delta = \{\operatorname{diag}(\Delta_1,\dots,\Delta_m)\}`.
+
+    ``M`` must have ``ncols`` rows and ``nrows`` columns (it maps ``w`` to
+    ``z``; ``Delta`` maps ``z`` back to ``w``).
+
+    Examples
+    --------
+    >>> S = BlockStructure([Block.real(1, "k1"), Block.full(2, name="performance")])
+    >>> S.nrows, S.ncols
+    (3, 3)
+    """
+
+    def __init__(self, blocks: Sequence[Block]):
+        blocks = tuple(blocks)
+        if not blocks:
+            raise ModelError("a block structure needs at least one block")
+        for b in blocks:
+            if not isinstance(b, Block):
+                raise ModelError(f"expected Block instances, got {type(b).__name__}")
+        self.blocks = blocks
+        self.row_slices, self.col_slices = [], []
+        r = c = 0
+        for b in blocks:
+            self.row_slices.append(slice(r, r + b.rows))
+            self.col_slices.append(slice(c, c + b.cols))
+            r += b.rows
+            c += b.cols
+        self.nrows, self.ncols = r, c
+        #: block index of each row / column of Delta (w and z entries)
+        self.row_block = np.concatenate([np.full(b.rows, k) for k, b in enumerate(blocks)])
+        self.col_block = np.concatenate([np.full(b.cols, k) for k, b in enumerate(blocks)])
+
+    # -- description -------------------------------------------------------
+    @classmethod
+    def from_spec(cls, spec) -> "BlockStructure":
+        """From a list like MATLAB's ``blk``: ``[r, c]`` full block, ``[-n, 0]``
+        repeated real scalar, ``[n, 0]`` repeated complex scalar."""
+        blocks = []
+        for item in spec:
+            r, c = (int(v) for v in item)
+            if c == 0:
+                blocks.append(Block.real(-r) if r < 0 else Block.scalar(r))
+            else:
+                blocks.append(Block.full(r, c))
+        return cls(blocks)
+
+    def __len__(self):
+        return len(self.blocks)
+
+    def __iter__(self):
+        return iter(self.blocks)
+
+    def __eq__(self, other):
+        return isinstance(other, BlockStructure) and self.blocks == other.blocks
+
+    def __repr__(self):
+        parts = []
+        for b in self.blocks:
+            nm = f" {b.name}" if b.name else ""
+            if b.kind == "full":
+                parts.append(f"full {b.rows}x{b.cols}{nm}")
+            else:
+                parts.append(f"{b.kind} x{b.rows}{nm}")
+        return "BlockStructure[" + ", ".join(parts) + "]"
+
+    @property
+    def has_real(self) -> bool:
+        return any(b.kind == "real" for b in self.blocks)
+
+    @property
+    def diagonal_scalings(self) -> bool:
+        """True when optimal D-scalings are one scalar per block."""
+        return all(b.diagonal_scaling for b in self.blocks)
+
+    def complexified(self) -> "BlockStructure":
+        """The same structure with real blocks replaced by complex scalars."""
+        return BlockStructure([Block("scalar", b.rows, b.cols, b.name) if b.kind == "real" else b
+                               for b in self.blocks])
+
+    def check(self, M) -> np.ndarray:
+        """Return ``M`` as a complex array after checking its size against the structure."""
+        M = np.asarray(M)
+        if M.ndim != 2:
+            raise ModelError(f"M must be a matrix, got an array with {M.ndim} dimensions")
+        if M.shape != (self.ncols, self.nrows):
+            raise ModelError(f"M is {M.shape[0]}x{M.shape[1]} but the block structure {self!r} "
+                             f"needs {self.ncols}x{self.nrows} (rows = total block columns, "
+                             f"columns = total block rows)")
+        M = M.astype(complex)
+        if not np.all(np.isfinite(M)):
+            raise ModelError("M contains non-finite entries")
+        # subnormal parts (below 2.2e-308) next to normal entries: zero them.  mu moves by about
+        # 1e-308 relative, and the scalings would otherwise meet numbers that some loaded
+        # libraries make the CPU read as zero (0/0 inside the SVD)
+        tiny = np.finfo(float).tiny
+        if np.abs(M).max(initial=0.0) >= tiny:
+            re, im = M.real.copy(), M.imag.copy()
+            re[np.abs(re) < tiny] = 0.0
+            im[np.abs(im) < tiny] = 0.0
+            M = re + 1j * im
+        return M
+
+    # -- perturbations -----------------------------------------------------
+    def assemble(self, parts: Sequence) -> np.ndarray:
+        """Block-diagonal ``Delta`` from one entry per block (a scalar for
+        scalar/real blocks, a matrix for full blocks)."""
+        if len(parts) != len(self.blocks):
+            raise ModelError(f"expected {len(self.blocks)} blocks, got {len(parts)}")
+        D = np.zeros((self.nrows, self.ncols), dtype=complex)
+        for b, rs, cs, p in zip(self.blocks, self.row_slices, self.col_slices, parts):
+            if b.kind == "full":
+                p = np.asarray(p, dtype=complex).reshape(b.rows, b.cols)
+                D[rs, cs] = p
+            else:
+                p = complex(np.asarray(p).item())
+                if b.kind == "real" and abs(p.imag) > 1e-12 * max(1.0, abs(p)):
+                    raise ModelError(f"block {b.name or 'real'} is real; got {p}")
+                D[rs, cs] = (p.real if b.kind == "real" else p) * np.eye(b.rows)
+        return D
+
+    def random(self, rng=None, norm: float = 1.0) -> np.ndarray:
+        """A random member with every block of norm at most ``norm`` (at least one equal)."""
+        rng = np.random.default_rng(rng)
+        parts = []
+        for b in self.blocks:
+            if b.kind == "real":
+                parts.append(rng.uniform(-1, 1))
+            elif b.kind == "scalar":
+                parts.append(rng.uniform(0, 1) * np.exp(2j * np.pi * rng.uniform()))
+            else:
+                X = rng.standard_normal((b.rows, b.cols)) + 1j * rng.standard_normal((b.rows, b.cols))
+                parts.append(X / np.linalg.norm(X, 2) * rng.uniform(0, 1))
+        D = self.assemble(parts)
+        return D * (norm / np.linalg.norm(D, 2))
+
+    def block_norms(self, Delta) -> np.ndarray:
+        return np.array([np.linalg.norm(np.asarray(Delta)[rs, cs], 2)
+                         for rs, cs in zip(self.row_slices, self.col_slices)])
+
+    def contains(self, Delta, tol: float = 1e-10) -> bool:
+        """True if ``Delta`` has this structure (zero off-diagonal blocks, real/repeated blocks)."""
+        Delta = np.asarray(Delta)
+        if Delta.shape != (self.nrows, self.ncols):
+            return False
+        scale = max(1.0, np.abs(Delta).max(initial=0.0))
+        mask = np.zeros(Delta.shape, bool)
+        for b, rs, cs in zip(self.blocks, self.row_slices, self.col_slices):
+            mask[rs, cs] = True
+            X = Delta[rs, cs]
+            if b.kind != "full":
+                d = X[0, 0]
+                if np.abs(X - d * np.eye(b.rows)).max() > tol * scale:
+                    return False
+                if b.kind == "real" and abs(d.imag) > tol * scale:
+                    return False
+        return bool(np.abs(Delta[~mask]).max(initial=0.0) <= tol * scale)
+
+    # -- scalings ------------------------------------------------------------
+    def expand_d(self, d) -> tuple[np.ndarray, np.ndarray]:
+        """Diagonal scalings ``(dl, dr)`` (length ``ncols`` and ``nrows``) from one
+        positive number per block: ``D_l = diag(dl)`` acts on ``z`` and
+        ``D_r = diag(dr)`` on ``w``."""
+        d = np.asarray(d, dtype=float)
+        dl = np.concatenate([np.full(b.cols, v) for b, v in zip(self.blocks, d)])
+        dr = np.concatenate([np.full(b.rows, v) for b, v in zip(self.blocks, d)])
+        return dl, dr
+
+
+def _as_structure(structure, what: str = "structure") -> "BlockStructure":
+    """``structure`` as a :class:`BlockStructure` (a list of :class:`Block` or a
+    MATLAB-like ``blk`` spec is converted), or a :class:`ModelError` naming it."""
+    if isinstance(structure, BlockStructure):
+        return structure
+    if structure is None or isinstance(structure, (str, bytes, int, float, complex, np.ndarray)) \
+            and not (isinstance(structure, np.ndarray) and structure.ndim == 2):
+        raise ModelError(f"{what} must be a BlockStructure (e.g. BlockStructure([Block.scalar(), "
+                         f"Block.full(2)])), got {structure!r}")
+    try:
+        items = list(structure)
+    except TypeError:
+        raise ModelError(f"{what} must be a BlockStructure, got {type(structure).__name__}") from None
+    if items and all(isinstance(b, Block) for b in items):
+        return BlockStructure(items)
+    try:
+        return BlockStructure.from_spec(items)
+    except (TypeError, ValueError) as exc:
+        if isinstance(exc, ModelError):
+            raise
+        raise ModelError(f"{what}: {structure!r} is neither a BlockStructure nor a list of Blocks nor a "
+                         f"blk spec like [[1, 1], [-1, 0]] ({exc})") from None
+
+
+def _norm2(M) -> float:
+    """Largest singular value, computed on a scaled copy so that entries near the
+    overflow or underflow limits do not break the SVD (inf if it overflows)."""
+    M = np.asarray(M)
+    amax = float(np.abs(M).max(initial=0.0))
+    if amax == 0 or not np.isfinite(amax):
+        return amax
+    if amax < np.finfo(float).tiny:
+        # subnormal numbers: some loaded libraries set the CPU to read them as zero, so no
+        # arithmetic on them can be trusted
+        raise ModelError(f"M's entries are all subnormal (largest {amax:.3g} < {np.finfo(float).tiny:.3g}): "
+                         "scale M up (mu(cM) = |c| mu(M))")
+    with np.errstate(over="ignore"):
+        return float(np.linalg.norm(M / amax, 2) * amax)
