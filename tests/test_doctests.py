@@ -17,12 +17,6 @@ matplotlib.use("Agg")      # an example that draws must not need a display
 
 PACKAGE = Path(__file__).resolve().parents[1] / "mutext"
 
-#: Modules being reworked elsewhere while this test was written, with the follow-up: their examples
-#: still run, but a failure is reported as an expected one until the entry is removed.
-IN_REWORK = {
-    "mutext.hinf": "hinf.py is being reworked (issue 18 follow-up: hinfsyn's Examples print np.float64(...))",
-}
-
 
 def _modules_with_examples() -> list[str]:
     names = []
@@ -32,8 +26,7 @@ def _modules_with_examples() -> list[str]:
             if parts[-1] == "__init__":
                 parts.pop()
             names.append(".".join(parts))
-    return [pytest.param(n, marks=pytest.mark.xfail(reason=IN_REWORK[n], strict=False)) if n in IN_REWORK else n
-            for n in names]
+    return names
 
 
 @pytest.mark.parametrize("name", _modules_with_examples())
@@ -45,11 +38,12 @@ def test_docstring_examples(name):
 
 
 def test_the_first_functions_a_student_calls_have_examples():
-    # hinfsyn (hinf.py), mu_bounds (mu.py) and dk_iteration (dk.py) are checked once their rework lands
     from mutext.diagnose import diagnose
+    from mutext.hinf import hinfsyn
+    from mutext.mu import mu_bounds
     from mutext.mbi import identify
     from mutext.rig import read_frf
     from mutext.rotor.analysis import frf
     from mutext.rotor.model import load_model
-    for fn in (identify, load_model, frf, read_frf, diagnose):
+    for fn in (hinfsyn, mu_bounds, identify, load_model, frf, read_frf, diagnose):
         assert ">>> " in (fn.__doc__ or ""), f"{fn.__module__}.{fn.__qualname__} has no Examples"

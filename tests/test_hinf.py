@@ -54,9 +54,10 @@ def test_two_mass_controller_achieves_level(two_mass_result):
 
 
 def test_two_mass_without_scaling_is_less_accurate():
-    """The naive formulation (no state scaling) is the reason scaling exists."""
+    """The naive LMI formulation (no state scaling) is the reason scaling exists."""
     P = two_mass.plant()
-    res = hinfsyn(P, 1, 1, scale=False, refine=False)
+    res = hinfsyn(P, 1, 1, scale=False, refine=False, method="lmi")
+    assert res.construction.startswith("LMI")
     check_result(res, P, 1, 1)
 
 

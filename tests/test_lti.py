@@ -302,3 +302,58 @@ def test_hinf_norm_stiff_closed_loop_matches_mpmath_peak():
     nrm = hinf_norm(CL)
     assert np.isfinite(nrm.value)
     assert nrm.value == pytest.approx(dc, rel=1e-6)
+
+
+# ------------------------------------------- stability test (issue 20)
+
+def test_stability_integrator_hidden_in_stiff_system_is_not_called_stable():
+    """An integrator and an undamped mode at 3 rad/s beside poles at -1e-6 and -1e8, hidden by a
+    random similarity: their computed real parts are rounding noise of either sign (the raw sign
+    test called the loop stable whenever the noise came out negative).  The scale-aware test
+    must refuse on every seed and name the pole it could not decide."""
+    from mutext.lti import is_stable, stability
+    raw_said_stable = 0
+    for seed in range(8):
+        rng = np.random.default_rng(seed)
+        A0 = np.zeros((5, 5))
+        A0[1:3, 1:3] = [[0.0, 3.0], [-3.0, 0.0]]
+        A0[3, 3], A0[4, 4] = -1e-6, -1e8
+        T = rng.standard_normal((5, 5)) + 3 * np.eye(5)
+        A = np.linalg.solve(T, A0 @ T)
+        G = ss(A, np.ones((5, 1)), np.ones((1, 5)), [[0.0]])
+        raw_said_stable += bool(np.all(np.linalg.eigvals(A).real < 0))
+        st = stability(G)
+        assert not st.stable and not is_stable(G)
+        assert "within rounding of the imaginary axis" in st.message
+        # the pole named is one of the two constructed on the axis (0 or +-3j)
+        assert min(abs(st.worst), abs(abs(st.worst) - 3.0)) < 1e-6, st.message
+    assert raw_said_stable < 8          # the raw sign is not a decision here
+
+
+@pytest.mark.parametrize("seed", range(5))
+def test_stability_slow_pole_beside_fast_one_under_bad_state_scaling(seed):
+    """Poles at -1e-6, -1e8 and -0.1 +- 2j (known by construction), states scaled by 1e-8..1e8:
+    stable, with the slow pole as the closest one and its own threshold far below 1e-6."""
+    from mutext.lti import is_stable, stability
+    rng = np.random.default_rng(seed)
+    A0 = np.diag([-1e-6, -1e8, -1.0, -3.0])
+    A0 = np.block([[A0, np.zeros((4, 2))], [np.zeros((2, 4)), np.array([[-0.1, 2.0], [-2.0, -0.1]])]])
+    t = 10.0 ** rng.uniform(-8, 8, 6)
+    A = A0 / t[:, None] * t[None, :]
+    G = ss(A, rng.standard_normal((6, 1)) / t[:, None], rng.standard_normal((1, 6)) * t[None, :], [[0.0]])
+    st = stability(G)
+    assert st.stable and is_stable(G)
+    assert st.worst.real == pytest.approx(-1e-6, rel=1e-6)
+    assert st.thresholds[np.argmin(np.abs(st.poles + 1e-6))] < 1e-6
+    # with a margin the slow pole fails, by name
+    st = stability(G, margin=1e-3)
+    assert not st.stable and "margin" in st.message and "-1e-06" in st.message
+
+
+def test_stability_unstable_pole_is_named():
+    from mutext.lti import stability
+    G = ss(np.diag([1e-3, -1e8, -1.0]), np.ones((3, 1)), np.ones((1, 3)), [[0.0]])
+    st = stability(G)
+    assert not st.stable
+    assert st.message.startswith("unstable: pole at s = 0.001 (real part 0.001")
+    assert st.max_real_part == pytest.approx(1e-3, rel=1e-9)

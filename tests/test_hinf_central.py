@@ -1,0 +1,285 @@
+"""Issue 20, deliverable 3: H-infinity controllers that achieve their level on badly scaled plants.
+
+Everything is checked against references independent of mutext:
+
+* the closed loop is rebuilt by python-control (``StateSpace.lft``) and its poles by numpy;
+* its norm by SLICOT AB13DD through python-control (``control.linfnorm``, equilibrated)
+  and by a dense complex solve of ``C (jwI - A)^-1 B + D`` written here (scipy's
+  diagonal balancing, numpy's LU) at AB13DD's peak and on a grid;
+* the level by SLICOT SB10AD (slycot): at ``gamma (1 - 1e-3)`` it must not produce a
+  controller that achieves that level (it refuses, or its controller misses), and in
+  the slow test its full gamma iteration (``control.hinfsyn``) must agree with ours
+  wherever its own controller achieves its claim.
+"""
+import warnings
+
+import control as ct
+import numpy as np
+import pytest
+import scipy.linalg as sla
+
+from mutext.examples import random_plants, two_mass
+from mutext.hinf import hinfsyn, slycot_hinfsyn
+from mutext.lti import ss
+
+FAMILY = range(60)
+
+
+def scaled_plant(seed, k=3.0):
+    """A random plant of :mod:`mutext.examples.random_plants` (states, time, u and y already
+    scaled by up to 10^+-2) scaled once more: states, every input, every output and the
+    time axis by independent factors 10^U(-k, k).  State units then span up to 1e10."""
+    rp = random_plants.random_plant(seed)
+    rng = np.random.default_rng(10_000 + seed)
+    A, B, C, D = (np.asarray(X, float) for X in (rp.P.A, rp.P.B, rp.P.C, rp.P.D))
+    n, m, p = A.shape[0], B.shape[1], C.shape[0]
+    t = 10.0 ** rng.uniform(-k, k, n)          # x = diag(t) x_new
+    si = 10.0 ** rng.uniform(-k, k, m)         # inputs [w; u] in new units
+    so = 10.0 ** rng.uniform(-k, k, p)         # outputs [z; y] in new units
+    c = 10.0 ** rng.uniform(-k, k)             # time scale: P(s / c)
+    A = c * A * t[None, :] / t[:, None]
+    B = c * B / t[:, None] * si[None, :]
+    C = C * t[None, :] * so[:, None]
+    D = D * si[None, :] * so[:, None]
+    return ss(A, B, C, D), rp.nmeas, rp.ncon
+
+
+def dense_gain(sys, w):
+    """sigma_max(C (jwI - A)^-1 B + D) by one dense complex LU per frequency, on the
+    states balanced by scipy (an exact diagonal similarity)."""
+    A, B, C, D = (np.asarray(X, float) for X in (sys.A, sys.B, sys.C, sys.D))
+    _, (sc, _) = sla.matrix_balance(A, permute=False, separate=True)
+    A, B, C = A / sc[:, None] * sc[None, :], B / sc[:, None], C * sc[None, :]
+    w = np.atleast_1d(np.asarray(w, float))
+    M = np.broadcast_to(-A, (w.size,) + A.shape).astype(complex)
+    M[:, np.arange(A.shape[0]), np.arange(A.shape[0])] += 1j * w[:, None]
+    G = C[None] @ np.linalg.solve(M, B[None]) + D[None]
+    return np.linalg.svd(G, compute_uv=False)[:, 0]
+
+
+def independent_norm(CL, agree=1e-4):
+    """(stable, norm) of a closed loop: AB13DD's norm, confirmed by a dense solve at its peak
+    frequency and on a grid; the larger of the two is returned.  With ``agree=None`` a
+    disagreement gives ``nan`` instead of failing (for other tools' controllers).
+
+    The two agree to 1e-4, not to rounding: these loops are ill-conditioned (seed 8: the peak
+    is the DC gain of a closed loop whose A has condition number 1.7e24; in 50-digit
+    arithmetic it is 3307539.9248, the dense solve gives 3307540.97 and AB13DD 3307587.5).
+    On slycot's controllers (poles up to 1e10 rad/s) they can differ by 5 % or more."""
+    poles = np.linalg.eigvals(np.asarray(CL.A, float))
+    if not np.all(poles.real < 0):
+        return False, np.inf
+    gpk, fpk = ct.linfnorm(CL)
+    mags = np.abs(poles)
+    grid = np.concatenate([[0.0, fpk], np.logspace(np.log10(mags.min()) - 3, np.log10(mags.max()) + 3, 300)])
+    g = dense_gain(CL, grid)
+    # AB13DD's peak is a gain the system has, and nothing on the grid exceeds it
+    consistent = abs(g[1] / gpk - 1) <= (agree or 1e-4) and g.max() <= gpk * (1 + (agree or 1e-4))
+    if agree is None and not consistent:
+        return True, float("nan")
+    assert consistent, (gpk, g[1], g.max())
+    return True, float(max(gpk, g.max()))
+
+
+def slicot_refuses_below(P, nmeas, ncon, level):
+    """True if SLICOT SB10AD at fixed ``level`` finds no controller achieving it: it refuses,
+    or the closed loop with its controller is unstable or has a larger norm."""
+    from slycot import sb10ad
+    A, B, C, D = (np.asarray(X, float) for X in (P.A, P.B, P.C, P.D))
+    try:
+        out = sb10ad(A.shape[0], B.shape[1], C.shape[0], ncon, nmeas, level, A, B, C, D, job=4)
+    except Exception:   # slycot raises several error types; each one is a refusal
+        return True
+    CL = P.lft(ct.ss(*out[1:5]), nu=ncon, ny=nmeas)
+    stable, achieved = independent_norm(CL)
+    return (not stable) or achieved > level
+
+
+def check_level_and_controller(P, nmeas, ncon, res, tol=1e-3):
+    CL = P.lft(res.K, nu=ncon, ny=nmeas)                   # python-control's interconnection
+    stable, achieved = independent_norm(CL)
+    assert stable
+    # the controller achieves the level to tol, and the level is not above what it achieves
+    assert achieved <= res.gamma * (1 + tol), (achieved, res.gamma)
+    assert res.gamma <= achieved * (1 + 1e-4)
+    assert res.closed_loop_norm == pytest.approx(achieved, rel=1e-4)
+    # SLICOT finds no controller 0.1 % below the level
+    assert slicot_refuses_below(P, nmeas, ncon, res.gamma * (1 - tol))
+    return achieved
+
+
+@pytest.mark.parametrize("seed", FAMILY)
+def test_badly_scaled_plant_controller_achieves_level(seed):
+    P, nmeas, ncon = scaled_plant(seed)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        res = hinfsyn(P, nmeas, ncon)
+    assert res.construction.startswith("central")
+    check_level_and_controller(P, nmeas, ncon, res)
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("seed", FAMILY)
+def test_badly_scaled_plant_level_agrees_with_slycot_hinfsyn(seed):
+    """slycot's full gamma iteration (``control.hinfsyn``, 10 s limit); compared only where its
+    controller, checked by python-control and AB13DD, achieves its claim to 1e-4 (on this family
+    it times out or misses its claim on about half of the plants)."""
+    P, nmeas, ncon = scaled_plant(seed)
+    ref = slycot_hinfsyn(P, nmeas, ncon, timeout=10)
+    if ref.status in ("timeout", "error"):
+        pytest.skip(f"slycot: {ref.status} {ref.note}")
+    stable, achieved = independent_norm(P.lft(ref.K, nu=ncon, ny=nmeas), agree=None)
+    if not stable or not abs(achieved / ref.gamma - 1) <= 1e-4:
+        pytest.skip(f"slycot claims {ref.gamma:.7g}, its controller achieves {achieved:.7g} "
+                    "(AB13DD and the dense solve, nan where they disagree)")
+    res = hinfsyn(P, nmeas, ncon)
+    # slycot's level carries its own tolerance (its iteration stops above the optimum, by
+    # 8e-4 on seed 17, where our controller achieves less than slycot's claims): the two
+    # agree to 1e-3 and our controller does at least as well as slycot's
+    assert res.gamma == pytest.approx(ref.gamma, rel=1e-3)
+    assert res.closed_loop_norm <= achieved * (1 + 1e-4)
+
+
+# ---------------------------------------------------------------- the singular and scaled cases of the issue
+
+def _two_mass(which=None, value=None, c=1.0):
+    P = two_mass.plant()
+    A, B, C, D = (np.asarray(X, float) for X in (P.A, P.B, P.C, P.D))
+    if which == "D12":
+        D[1, 2] = value        # z2 = value * u
+    elif which == "D21":
+        D[2, 1] = value        # y = ... + value * w2
+    return ss(A * c, B * c, C * c, D * c)
+
+
+@pytest.mark.parametrize("which", ["D12", "D21"])
+def test_nearly_singular_two_mass(which):
+    """D12 or D21 = 1e-5: the LMI controller sat at 30 % back-off (issue 20); the central
+    controller achieves the level at 1e-4.  slycot's gamma iteration answers here."""
+    P = _two_mass(which, 1e-5)
+    res = hinfsyn(P, 1, 1)
+    achieved = check_level_and_controller(P, 1, 1, res)
+    assert res.backoff <= 1e-3
+    ref = slycot_hinfsyn(P, 1, 1, timeout=30)
+    assert ref.status in ("verified", "unverified"), ref.note
+    # slycot's level is within 1e-4 of ours (D21: its claim is 8e-6 below the level its own
+    # controller achieves, and below ours, which our controller confirms to 1e-4)
+    assert res.gamma == pytest.approx(ref.gamma, rel=1e-4)
+    assert achieved <= ref.achieved * (1 + 1e-4)
+
+
+@pytest.mark.parametrize("c", [1e8, 1e-4])
+def test_two_mass_scaled_by_constant(c):
+    """Every matrix times c: P'(s) = c P(s / c), level c * gamma.  At 1e8 slycot's own
+    iteration does not return within a minute; the reference is slycot's level of the
+    unscaled plant times c."""
+    ref = slycot_hinfsyn(two_mass.plant(), 1, 1, timeout=30)
+    assert ref.status == "verified"
+    P = _two_mass(c=c)
+    res = hinfsyn(P, 1, 1)
+    achieved = check_level_and_controller(P, 1, 1, res)
+    assert res.gamma / c == pytest.approx(ref.gamma, rel=1e-5)
+    assert achieved / c <= ref.gamma * (1 + 2e-4)
+
+
+def test_near_axis_plant_controller_achieves_level():
+    """The D-scaled distillation plant with weight poles at -1e-6 rad/s (tests/data): the LMI
+    controller needed 10 % back-off or failed; the central controller reaches 1e-4."""
+    from pathlib import Path
+    data = np.load(Path(__file__).parent / "data" / "near_axis_plant.npz")
+    P = ss(data["A"], data["B"], data["C"], data["D"])
+    res = hinfsyn(P, 2, 2)
+    check_level_and_controller(P, 2, 2, res)
+    assert res.backoff <= 1e-3
+    ref = slycot_hinfsyn(P, 2, 2, timeout=30)
+    if ref.status == "verified":
+        assert res.gamma == pytest.approx(ref.gamma, rel=1e-5)
+
+
+def test_construction_and_level_method_are_reported():
+    P = two_mass.plant()
+    res = hinfsyn(P, 1, 1)
+    assert res.construction.startswith("central") and "Riccati" in res.info["level_method"]
+    lmi = hinfsyn(P, 1, 1, method="lmi")
+    assert lmi.construction.startswith("LMI") and lmi.info["level_method"].startswith("LMI")
+    # both routes reach the same level, each proven by its own controller (AB13DD)
+    for r in (res, lmi):
+        check_level_and_controller(P, 1, 1, r)
+    assert res.gamma == pytest.approx(lmi.gamma, rel=1e-6)
+
+
+def test_nearly_singular_d21_better_than_slycot():
+    """D21 = 1e-6: slycot's gamma iteration stops at 0.86345 (its controller achieves that);
+    the central controller achieves 0.8447 (AB13DD and a dense solve), and SLICOT finds no
+    controller 0.1 % below our level.  slycot's level is 2 % above the optimum here."""
+    P = _two_mass("D21", 1e-6)
+    res = hinfsyn(P, 1, 1)
+    achieved = check_level_and_controller(P, 1, 1, res)
+    ref = slycot_hinfsyn(P, 1, 1, timeout=30)
+    assert ref.status == "verified"
+    assert achieved < ref.achieved * (1 - 1e-2)
+
+
+def test_singular_d21_regularised_central_controller():
+    """D21 = 0 (noise-free measurement, the structure of model-based identification): outside
+    the Riccati assumptions.  The LMI level read 0.8187 and its controller achieved 0.8175; the
+    central controllers of regularised plants reach 0.8070 (AB13DD and a dense solve).  An
+    independent upper bound of the singular infimum: slycot's verified level of the plant with
+    D21 = 1e-6 (0.8635).  No independent lower bound is available (slycot refuses D21 = 0)."""
+    P = _two_mass("D21", 0.0)
+    res = hinfsyn(P, 1, 1)
+    assert "regularised" in res.construction
+    stable, achieved = independent_norm(P.lft(res.K, nu=1, ny=1))
+    assert stable
+    assert res.gamma == pytest.approx(achieved, rel=1e-4)
+    ref = slycot_hinfsyn(_two_mass("D21", 1e-6), 1, 1, timeout=30)
+    assert ref.status == "verified"
+    assert achieved <= ref.achieved
+
+
+def test_closed_loop_stability_verdict_names_the_deciding_pole():
+    """The verdict recorded with the result names the closed-loop pole closest to failing;
+    it is python-control's rightmost closed-loop pole."""
+    import re
+    P, nmeas, ncon = scaled_plant(3)
+    res = hinfsyn(P, nmeas, ncon)
+    m = re.search(r"closest is the pole at s = (\S+) \(real part (\S+), threshold (\S+)\)", res.info["stability"])
+    assert m, res.info["stability"]
+    poles = P.lft(res.K, nu=ncon, ny=nmeas).poles()
+    assert float(m.group(2)) == pytest.approx(poles.real.max(), rel=1e-2)
+    assert float(m.group(3)) < 0
+
+
+@pytest.fixture(scope="module")
+def mbi_plants():
+    """The plants of the K steps of the cracked-rotor identification (``mutext demo crack``,
+    thesis data path): D21 ~ 1e-10 (measurement noise regularisation), lightly damped rotor
+    modes.  The LMI controller failed at every back-off on one of them, slycot times out."""
+    import mutext.dk as dkm
+    from mutext.demos import crack
+    cap = []
+    orig = dkm.dk_iteration
+
+    def record(P, structure, nmeas, ncon, **kw):
+        cap.append((P, nmeas, ncon))
+        return orig(P, structure, nmeas, ncon, **kw)
+    mp = pytest.MonkeyPatch()
+    mp.setattr(dkm, "dk_iteration", record)
+    try:
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")
+            crack.solve(out=None, thesis_tables=True)
+    finally:
+        mp.undo()
+    assert len(cap) >= 3
+    return cap
+
+
+@pytest.mark.slow
+def test_rotor_mbi_plants_controller_achieves_level(mbi_plants):
+    for P, nmeas, ncon in mbi_plants:
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")
+            res = hinfsyn(P, nmeas, ncon)
+        check_level_and_controller(P, nmeas, ncon, res)
+        assert res.backoff <= 1e-3
