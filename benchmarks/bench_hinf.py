@@ -22,14 +22,13 @@ Columns ``construction`` and ``level`` say how our controller was built (the
 central controller from the Riccati solutions, or the LMI reconstruction) and
 how the level was found (Riccati gamma iteration, or LMIs).
 
-``--sizes 10 20 30 40`` prints instead the cost as plants grow (issue 20,
-deliverable 5): random well-posed plants with 2 disturbances, 2 controls, 2
+``--sizes 10 20 30 40`` prints instead the cost as plants grow: random well-posed plants with 2 disturbances, 2 controls, 2
 errors and 2 measurements (generic ``D12``, ``D21``, half of them open-loop
 unstable; :func:`sized_plant`), ``--per-size`` plants per order, ours with the
 default ``method="auto"`` (and ``--lmi`` adds the LMI route) against slycot's
 ``hinfsyn`` in the same run, both verified on the rebuilt closed loop.
 
-Measured (issue 20; ``--sizes 10 20 30 40 --per-size 3``, one core of a shared
+Measured (``--sizes 10 20 30 40 --per-size 3``, one core of a shared
 machine; medians; d_gamma against slycot's claim)::
 
       n  t_slycot  t_ours  ratio  max |d_gamma|

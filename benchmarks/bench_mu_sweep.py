@@ -1,6 +1,6 @@
 """Benchmark: a mixed real/complex mu upper-bound sweep, mutext against SLICOT AB13MD, in one run.
 
-The problem of issue 17: a random stable 10-state system with 6 inputs and 6
+The problem: a random stable 10-state system with 6 inputs and 6
 outputs (seed 0), blocks ``r1 r1 C2x2 C1 C1`` (two real scalars, a full complex
 2x2 block and two complex 1x1 blocks), ``--points`` log-spaced frequencies
 from 1e-2 to 1e2 rad/s.  On the same frequencies:

@@ -1416,8 +1416,7 @@ def hinfsyn(P, nmeas: int, ncon: int, *, solver: str = "CLARABEL", backoff: floa
         (:func:`riccati_feasible`) and the central controller; the LMIs
         (level and controller) where that fails or the problem is singular.
         "riccati": that route only (an error where it fails).  "lmi": the
-        textbook LMI route only (level and controller from LMIs, as before
-        issue 20).
+        textbook LMI route only (level and controller from LMIs).
 
     Returns
     -------
