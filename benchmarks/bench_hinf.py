@@ -13,6 +13,11 @@ For every plant:
 * ours: the optimal level gamma and the controller, whose closed loop is
   rebuilt and its norm recomputed independently.
 
+Every verdict (slycot's and ours) comes from :func:`judge`, which does not use
+mutext's numerics: the loop closed by python-control, stability from the
+closed-loop poles in 40-digit arithmetic (mpmath), the norm by SLICOT AB13DD
+(``benchmarks/_independent.py``).
+
 Columns: ``d_gamma`` = (gamma_ours - gamma_slycot)/gamma_slycot;
 ``d_cl`` = (closed-loop norm of our controller - gamma_slycot)/gamma_slycot
 (negative is better than slycot's claim); ``CL_slycot`` = the closed-loop
@@ -57,11 +62,27 @@ import time
 import numpy as np
 
 
+def judge(P, K, nmeas, ncon):
+    """(closed-loop norm, stable, text) of a controller, by code independent of mutext
+    (``benchmarks/_independent.py``: python-control's loop, 40-digit poles, AB13DD)."""
+    import _independent as ind
+    CL = ind.closed_loop(P, K, nmeas, ncon)
+    stable, text = ind.stability(CL)
+    return (ind.hinf_norm(CL) if stable else float("inf")), stable, text
+
+
 def slycot_reference(P, nmeas, ncon, timeout):
-    """(status, gamma, note, seconds, achieved) from :func:`mutext.hinf.slycot_hinfsyn`."""
+    """(status, gamma, note, seconds, achieved) of slycot's ``hinfsyn``, its claim judged by :func:`judge`:
+    ``verified`` when its loop is stable and achieves the claimed gamma within 1e-3."""
     from mutext.hinf import slycot_hinfsyn
     r = slycot_hinfsyn(P, nmeas, ncon, timeout=timeout)
-    return r.status, r.gamma, r.note, r.seconds, r.achieved
+    if r.K is None:
+        return r.status, r.gamma, r.note, r.seconds, r.achieved
+    achieved, stable, text = judge(P, r.K, nmeas, ncon)
+    if stable and abs(achieved - r.gamma) <= 1e-3 * r.gamma:
+        return "verified", r.gamma, "", r.seconds, achieved
+    why = text if not stable else f"its controller achieves {achieved:.7g}, not the claimed {r.gamma:.7g}"
+    return "unverified", r.gamma, why, r.seconds, achieved
 
 
 def ours(P, nmeas, ncon):
@@ -72,10 +93,10 @@ def ours(P, nmeas, ncon):
         r = hinfsyn(P, nmeas, ncon)
     except MutextError as exc:
         return {"error": f"{type(exc).__name__}: {str(exc)[:80]}", "seconds": time.perf_counter() - t0}
-    return {"gamma": r.gamma, "cl": r.closed_loop_norm, "cl_slycot": r.closed_loop_norm_slycot,
-            "stable": r.stable, "backoff": r.backoff, "order": r.controller_order,
-            "method": r.info.get("level_method", ""), "construction": r.construction,
-            "seconds": time.perf_counter() - t0}
+    seconds = time.perf_counter() - t0
+    cl, stable, _ = judge(P, r.K, nmeas, ncon)
+    return {"gamma": r.gamma, "cl": cl, "stable": stable, "backoff": r.backoff, "order": r.controller_order,
+            "method": r.info.get("level_method", ""), "construction": r.construction, "seconds": seconds}
 
 
 def cases(count, first_seed):
@@ -143,7 +164,9 @@ def _sizes_child(n, seed, timeout, lmi, q):
         t0 = time.perf_counter()
         try:
             r = hinfsyn(P, 2, 2, method=method)
-            rows[method] = (r.gamma, r.closed_loop_norm, r.stable, time.perf_counter() - t0,
+            t = time.perf_counter() - t0
+            cl, stable, _ = judge(P, r.K, 2, 2)
+            rows[method] = (r.gamma, cl, stable, t,
                             r.construction.split(" ")[0], r.info["level_method"].split(" ")[0])
         except MutextError as exc:
             rows[method] = (np.nan, np.nan, False, time.perf_counter() - t0, f"failed: {type(exc).__name__}", "")

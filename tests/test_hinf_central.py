@@ -283,3 +283,24 @@ def test_rotor_mbi_plants_controller_achieves_level(mbi_plants):
             res = hinfsyn(P, nmeas, ncon)
         check_level_and_controller(P, nmeas, ncon, res)
         assert res.backoff <= 1e-3
+
+
+@pytest.mark.parametrize("c", [1e-3, 1e-6, pytest.param(1e-9, marks=pytest.mark.xfail(
+    strict=True, reason="the level comes out 1.2457e-9 instead of 1.0069e-9: the w -> z normalisation splits "
+                        "one factor between w and z, which leaves D21 at about sqrt(1e-9) against C2 and the "
+                        "filter problem nearly singular; scaling w and z separately fixes this plant but breaks "
+                        "3 of the 60 badly scaled ones"))])
+def test_optimal_level_near_zero(c):
+    # scaling the disturbance inputs by c scales every closed-loop map from w, hence the
+    # optimal level, by exactly c: a plant with a level near 0 is this plant's level times c
+    P = two_mass.plant(two_mass.THESIS)
+    nw = P.ninputs - 1
+    A, B, C, D = (np.asarray(X, float) for X in (P.A, P.B, P.C, P.D))
+    B, D = B.copy(), D.copy()
+    B[:, :nw] *= c
+    D[:, :nw] *= c
+    Pc = ss(A, B, C, D)
+    g1 = hinfsyn(P, 1, 1).gamma
+    res = hinfsyn(Pc, 1, 1)
+    assert res.gamma == pytest.approx(c * g1, rel=1e-4)
+    check_level_and_controller(Pc, 1, 1, res)
