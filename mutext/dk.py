@@ -778,6 +778,18 @@ def dk_iteration(P, structure: BlockStructure, nmeas: int, ncon: int, *, omega=N
     IllPosedError, InfeasibleError, SolverError
         The first K step failed (later failures end the iteration and keep the
         best controller found, with a note).
+
+    Examples
+    --------
+    Robust performance of the thesis's two-mass problem with the bound on
+    :math:`x_1` at 0.043 m and +/-2 % on every parameter (a few seconds):
+
+    >>> from mutext.examples import two_mass_uncertain as tmu
+    >>> res = dk_iteration(tmu.plant(0.043), tmu.structure(), 1, 1)
+    >>> bool(res.mu_upper < 1), bool(res.mu_lower <= res.mu_upper)
+    (True, True)
+    >>> res.controller_order <= tmu.plant(0.043).nstates + 12
+    True
     """
     t0 = time.perf_counter()
     P = as_ss(P, "P")

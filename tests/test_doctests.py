@@ -39,11 +39,12 @@ def test_docstring_examples(name):
 
 def test_the_first_functions_a_student_calls_have_examples():
     from mutext.diagnose import diagnose
+    from mutext.dk import dk_iteration
     from mutext.hinf import hinfsyn
     from mutext.mu import mu_bounds
     from mutext.mbi import identify
     from mutext.rig import read_frf
     from mutext.rotor.analysis import frf
     from mutext.rotor.model import load_model
-    for fn in (hinfsyn, mu_bounds, identify, load_model, frf, read_frf, diagnose):
+    for fn in (hinfsyn, mu_bounds, dk_iteration, identify, load_model, frf, read_frf, diagnose):
         assert ">>> " in (fn.__doc__ or ""), f"{fn.__module__}.{fn.__qualname__} has no Examples"
