@@ -475,7 +475,7 @@ def _port_index(spec, labels: Sequence[str], n: int, what: str) -> int:
     raise ModelError(f"measure: {what} must be an index or a name, got {spec!r}")
 
 
-def _response(system, input, output, omega) -> np.ndarray:
+def _response(system, in_port, out_port, omega) -> np.ndarray:
     """Frequency response of one channel at omega [rad/s]."""
     import control as ct
 
@@ -483,32 +483,32 @@ def _response(system, input, output, omega) -> np.ndarray:
             isinstance(system, tuple) and len(system) == 4):
         from .lti import as_ss, freqresp
         sys = as_ss(system, "measure: system")
-        i = _port_index(input, sys.input_labels, sys.ninputs, "input")
-        o = _port_index(output, sys.output_labels, sys.noutputs, "output")
+        i = _port_index(in_port, sys.input_labels, sys.ninputs, "input")
+        o = _port_index(out_port, sys.output_labels, sys.noutputs, "output")
         return freqresp(sys, omega)[o, i, :]
     if callable(system):
         G = np.asarray(system(omega), dtype=complex)
         if G.shape == omega.shape:
-            if input not in (0, None) or output not in (0, None):
-                raise ModelError("measure: a callable returning one channel takes input=0, output=0")
+            if in_port not in (0, None) or out_port not in (0, None):
+                raise ModelError("measure: a callable returning one channel takes in_port=0, out_port=0")
             return G
         if G.ndim == 3 and G.shape[2] == omega.size:
-            i = _port_index(input, [], G.shape[1], "input")
-            o = _port_index(output, [], G.shape[0], "output")
+            i = _port_index(in_port, [], G.shape[1], "input")
+            o = _port_index(out_port, [], G.shape[0], "output")
             return G[o, i, :]
         raise ModelError(f"measure: the callable returned shape {G.shape}; expected "
                          f"({omega.size},) or (noutputs, ninputs, {omega.size})")
     if hasattr(system, "frequency_response"):      # other python-control LTI objects (FRD, ...)
         G = np.asarray(system.frequency_response(omega, squeeze=False).fresp, dtype=complex)
-        i = _port_index(input, getattr(system, "input_labels", []), G.shape[1], "input")
-        o = _port_index(output, getattr(system, "output_labels", []), G.shape[0], "output")
+        i = _port_index(in_port, getattr(system, "input_labels", []), G.shape[1], "input")
+        o = _port_index(out_port, getattr(system, "output_labels", []), G.shape[0], "output")
         return G[o, i, :]
     raise ModelError(f"measure: cannot compute a frequency response of a {type(system).__name__}; "
                      f"pass a control.StateSpace/TransferFunction, an (A, B, C, D) tuple or a "
                      f"callable omega[rad/s] -> response")
 
 
-def measure(system, input=0, output=0, freq_hz=None, *, noise=None, rng=None,
+def measure(system, in_port=0, out_port=0, freq_hz=None, *, noise=None, rng=None,
             input_station: int | None = None, output_station: int | None = None,
             input_quantity: str = "force", output_quantity: str = "displacement",
             speed_hz: float | None = None, metadata: Mapping[str, str] | None = None,
@@ -521,7 +521,7 @@ def measure(system, input=0, output=0, freq_hz=None, *, noise=None, rng=None,
         The "rig".  Its response must be in SI units (m/N or m/A).  A callable
         maps angular frequencies [rad/s] to the response, either of shape
         ``(n,)`` (one channel) or ``(noutputs, ninputs, n)``.
-    input, output : int or str
+    in_port, out_port : int or str
         Channel: index or name (``input_labels`` / ``output_labels``).
     freq_hz : array_like, optional
         Frequencies [Hz]; default :func:`sweep_frequencies` (20-225 Hz,
@@ -548,7 +548,7 @@ def measure(system, input=0, output=0, freq_hz=None, *, noise=None, rng=None,
     """
     f = sweep_frequencies() if freq_hz is None else np.asarray(freq_hz, dtype=float).ravel()
     omega = 2.0 * np.pi * f
-    G = _response(system, input, output, omega)
+    G = _response(system, in_port, out_port, omega)
     meta = {str(k): str(v) for k, v in (metadata or {}).items()}
     nz = _as_noise(noise)
     if nz is not None and (nz.relative > 0 or nz.floor > 0):
@@ -558,16 +558,16 @@ def measure(system, input=0, output=0, freq_hz=None, *, noise=None, rng=None,
         meta["noise_relative"] = repr(nz.relative)
         meta["noise_floor"] = repr(nz.floor)
     names = {}
-    if isinstance(input, str):
-        names["input_name"] = input
-    if isinstance(output, str):
-        names["output_name"] = output
+    if isinstance(in_port, str):
+        names["input_name"] = in_port
+    if isinstance(out_port, str):
+        names["output_name"] = out_port
     return FRF(freq_hz=f, response=G, input_station=input_station, output_station=output_station,
                input_quantity=input_quantity, output_quantity=output_quantity, speed_hz=speed_hz,
                metadata=meta, input_direction=input_direction, output_direction=output_direction, **names)
 
 
-def measure_rotor(model, input: str, output: str, freq_hz=None, *, noise=None, rng=None,
+def measure_rotor(model, in_port: str, out_port: str, freq_hz=None, *, noise=None, rng=None,
                   harmonics: int = 6, cutoff_hz: float = 1000.0, revolutions: int = 40,
                   settle_s: float = 0.7, metadata: Mapping[str, str] | None = None) -> FRF:
     r"""Virtual sine sweep of a finite-element rotor, as the rig's analyzer measures it.
@@ -585,7 +585,7 @@ def measure_rotor(model, input: str, output: str, freq_hz=None, *, noise=None, r
     Parameters
     ----------
     model : mutext.rotor.Rotor
-    input, output : str
+    in_port, out_port : str
         Port names (e.g. ``"i12"``, ``"x13"``).
     freq_hz : array_like, optional
         Default :func:`sweep_frequencies` (20-225 Hz, 0.5 Hz).
@@ -602,10 +602,10 @@ def measure_rotor(model, input: str, output: str, freq_hz=None, *, noise=None, r
     """
     from .rotor.periodic import analyzer_frf, periodic_rotor
     f = sweep_frequencies() if freq_hz is None else np.asarray(freq_hz, dtype=float).ravel()
-    pr = periodic_rotor(model, inputs=[input], outputs=[output])
+    pr = periodic_rotor(model, inputs=[in_port], outputs=[out_port])
     meta = {str(k): str(v) for k, v in (metadata or {}).items()}
     if pr.time_invariant():
-        H = model.frf(f, inputs=[input], outputs=[output])
+        H = model.frf(f, inputs=[in_port], outputs=[out_port])
         meta.setdefault("analyzer", "time-invariant model: exact frequency response")
     else:
         red = pr.reduce(cutoff_hz, band_hz=(float(f.min()), float(f.max())))
@@ -614,7 +614,7 @@ def measure_rotor(model, input: str, output: str, freq_hz=None, *, noise=None, r
                                  f"{settle_s:g} s settling; harmonic balance N = {harmonics}",
                      "breathing": ", ".join(f"{c.name} {c.law}" for c in pr.cracks),
                      "reduction_error": f"{red.reduction_error:.3g}"})
-    ch = H.channel(output, input)
+    ch = H.channel(out_port, in_port)
     ch.metadata = meta
     return with_noise(ch, noise, rng=rng)
 

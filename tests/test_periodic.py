@@ -143,9 +143,9 @@ def test_bad_input_is_named():
     with pytest.raises(ModelError, match="cutoff"):
         pr.reduce(-5.0)
     with pytest.raises(ModelError, match="no input port 'no-such-port'.*i12"):
-        stepped_sine(pr, [30.0], input="no-such-port")
+        stepped_sine(pr, [30.0], in_port="no-such-port")
     with pytest.raises(ModelError, match="no output port 'x99'.*x13"):
-        stepped_sine(pr, [30.0], output="x99")
+        stepped_sine(pr, [30.0], out_port="x99")
 
 
 def test_crack_quadrature_points_are_checked():

@@ -510,7 +510,7 @@ def _port_index(names, name, kind: str) -> int:
     return list(names).index(name)
 
 
-def stepped_sine(model, freqs_hz, *, input: str | None = None, output: str | None = None,
+def stepped_sine(model, freqs_hz, *, in_port: str | None = None, out_port: str | None = None,
                  amplitude: float = ANALYZER["amplitude"], revolutions: int = ANALYZER["revolutions"],
                  settle_s: float = ANALYZER["settle_s"], excitation_phase: float = 0.0,
                  steps_per_rev: int | None = None, cutoff_hz: float = 1500.0, progress=None) -> dict:
@@ -537,8 +537,8 @@ def stepped_sine(model, freqs_hz, *, input: str | None = None, output: str | Non
     """
     t0 = time.perf_counter()
     pr = model if isinstance(model, PeriodicRotor) else periodic_rotor(model)
-    ii = _port_index(pr.inputs, input, "input")
-    oi = _port_index(pr.outputs, output, "output")
+    ii = _port_index(pr.inputs, in_port, "input")
+    oi = _port_index(pr.outputs, out_port, "output")
     f = _freqs(freqs_hz)
     if pr.basis is None:
         pr = pr.reduce(cutoff_hz)
