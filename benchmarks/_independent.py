@@ -6,7 +6,8 @@ move every verdict at once.  This module judges a controller with other code:
 
 * the loop is closed by python-control (:meth:`control.StateSpace.lft`);
 * stability is decided from the closed-loop eigenvalues computed in extended
-  precision (``mpmath.eig`` at 40 digits on the balanced A); a pole counts as
+  precision (``mpmath.eig`` at 40 digits on the balanced A; LAPACK in double
+  precision above 40 states, where mpmath takes minutes); a pole counts as
   unstable when its real part is positive by more than a margin relative to
   its own magnitude, so that a stiff loop (poles from 1e-6 to 1e8 rad/s) is
   judged pole by pole;
@@ -28,7 +29,8 @@ import numpy as np
 import scipy.linalg as sla
 from slycot import ab13md
 
-USED = ("loop: python-control StateSpace.lft; poles: mpmath.eig (40 digits) of the balanced A; "
+USED = ("loop: python-control StateSpace.lft; poles: mpmath.eig (40 digits) of the balanced A "
+        "(LAPACK above 40 states); "
         "responses: dense complex LU per frequency; mu: SLICOT AB13MD, peaks refined by golden section")
 
 
@@ -37,12 +39,19 @@ def closed_loop(P, K, nmeas: int, ncon: int) -> ct.StateSpace:
     return ct.ss(P).lft(ct.ss(K), nu=ncon, ny=nmeas)
 
 
+#: above this many states mpmath's eigenvalue solver takes minutes: LAPACK on the balanced A instead
+MP_MAX_STATES = 40
+
+
 def poles(sys, dps: int = 40) -> np.ndarray:
-    """Eigenvalues of ``sys.A`` in extended precision (after a similarity balancing)."""
+    """Eigenvalues of ``sys.A`` in extended precision (after a similarity balancing);
+    above :data:`MP_MAX_STATES` states in double precision (LAPACK, balanced)."""
     A = np.asarray(ct.ss(sys).A, float)
     if A.size == 0:
         return np.zeros(0, complex)
     Ab, _ = sla.matrix_balance(A, permute=False)   # exact: diagonal powers of 2
+    if A.shape[0] > MP_MAX_STATES:
+        return sla.eigvals(Ab)
     with mpmath.workdps(dps):
         ev = mpmath.eig(mpmath.matrix(Ab.tolist()), left=False, right=False)
     return np.array([complex(e) for e in ev])
