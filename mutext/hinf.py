@@ -1294,6 +1294,33 @@ def _search(P, nmeas, ncon, lev: _Level, schedule, tries: list, solver, controll
     return best, False
 
 
+#: a Riccati level this far below the plant's w -> z scale is 0 to double precision
+_ZERO_LEVEL = 1e-12
+
+
+def _zero_infimum(P, nmeas, ncon, lev: _Level, tries, solver, controller_objective, bound_factor, notes, best):
+    r"""The Riccati conditions hold at every level (e.g. square ``D12``, ``D21`` with
+    :math:`A - B_2 D_{12}^{-1} C_1` and :math:`A - B_1 D_{21}^{-1} C_2` stable:
+    :math:`X_\infty = Y_\infty = 0`): the infimum is 0 and is not attained, the
+    central controllers grow without bound as the level goes to 0.  Controllers are
+    built at levels 1e-1, 1e-2, ... of the plant's w -> z scale until one fails its
+    check; the lowest verified one is returned with its level."""
+    found = None
+    for k in range(1, 13):
+        trial = replace(lev, gamma=lev.gscale * 10.0 ** -k, status="zero infimum")
+        cand, ok = _search(P, nmeas, ncon, trial, [1e-4], tries, solver, controller_objective, bound_factor,
+                           central=True, lmi=False)
+        if not ok:
+            break
+        found = (cand, trial)
+    if found is None:
+        return best, False, lev
+    notes.append(f"the Riccati conditions hold at every level: the optimal level is 0 and is not attained "
+                 f"(controllers grow without bound as the level goes to 0); the controller returned is the "
+                 f"lowest of the levels 1e-1, 1e-2, ... times {lev.gscale:.3g} that passed its check")
+    return found[0], True, replace(found[1], method=lev.method + "; infimum 0, not attained")
+
+
 # ----------------------------------------------------------------------------
 # main entry point
 # ----------------------------------------------------------------------------
@@ -1476,6 +1503,9 @@ def hinfsyn(P, nmeas: int, ncon: int, *, solver: str = "CLARABEL", backoff: floa
         best = _regularised_search(P, nmeas, ncon, parts, scale, tries)
     best, passed = _search(P, nmeas, ncon, lev, schedule, tries, solver, controller_objective, bound_factor,
                            central=regular and method != "lmi", lmi=method != "riccati", first=best)
+    if not passed and lev.status == "riccati" and lev.gamma <= _ZERO_LEVEL * lev.gscale:
+        best, passed, lev = _zero_infimum(P, nmeas, ncon, lev, tries, solver, controller_objective,
+                                          bound_factor, notes, best)
     if not passed and method == "auto" and lev.R is None:
         # the Riccati route gave a level but no central controller passed the check:
         # the LMIs take over (level and controller), central controllers at the
@@ -1512,7 +1542,9 @@ def hinfsyn(P, nmeas: int, ncon: int, *, solver: str = "CLARABEL", backoff: floa
     elif b > 1e-3:
         notes.append(f"no controller passed the check closer to the optimum: the controller "
                      f"achieves {value:.6g}, {100 * (value / gamma - 1):.2g} % above the optimal level")
-    if value < gamma * (1 - 1e-6):
+    if value < gamma * (1 - 1e-6) and lev.status == "zero infimum":
+        gamma = value       # the level is 0; report what the returned controller proves
+    elif value < gamma * (1 - 1e-6):
         # a verified controller proves a lower level than the level computation returned
         notes.append(f"the controller achieves {value:.6g}, below the computed level {gamma:.6g}: the level "
                      "was computed inaccurately (on singular problems the infimum is approached only "

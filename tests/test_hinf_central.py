@@ -304,3 +304,26 @@ def test_optimal_level_near_zero(c):
     res = hinfsyn(Pc, 1, 1)
     assert res.gamma == pytest.approx(c * g1, rel=1e-4)
     check_level_and_controller(Pc, 1, 1, res)
+
+
+def test_level_zero_not_attained():
+    # square D12, D21 with A - B2 D12^-1 C1 and A - B1 D21^-1 C2 stable: X_inf = Y_inf = 0 at
+    # every level, so the optimal level is 0 and only approached by ever larger controllers
+    rng = np.random.default_rng(3)
+    n = 8
+    A = rng.standard_normal((n, n)) / np.sqrt(n)
+    A -= (np.linalg.eigvals(A).real.max() - 0.3) * np.eye(n)      # open-loop unstable
+    B2, C2 = rng.standard_normal((n, 2)), rng.standard_normal((2, n))
+    F = np.linalg.lstsq(B2, A + 2 * np.eye(n), rcond=None)[0]      # A - B2 F has poles near -2
+    L = np.linalg.lstsq(C2.T, (A + 2 * np.eye(n)).T, rcond=None)[0].T
+    D12, D21 = rng.standard_normal((2, 2)), rng.standard_normal((2, 2))
+    C1, B1 = D12 @ F, L @ D21
+    assert np.linalg.eigvals(A - B2 @ F).real.max() < 0 and np.linalg.eigvals(A - L @ C2).real.max() < 0
+    P = ss(A, np.hstack([B1, B2]), np.vstack([C1, C2]), np.block([[np.zeros((2, 2)), D12], [D21, np.zeros((2, 2))]]))
+    res = hinfsyn(P, 2, 2)
+    CL = P.lft(res.K, nu=2, ny=2)                                    # python-control's interconnection
+    assert np.linalg.eigvals(CL.A).real.max() < 0
+    achieved = ct.linfnorm(CL)[0]
+    assert achieved < 1e-6 * np.linalg.norm(B1) * np.linalg.norm(C1)
+    assert achieved == pytest.approx(res.gamma, rel=0.1)
+    assert any("not attained" in note for note in res.notes)
