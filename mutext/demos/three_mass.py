@@ -50,7 +50,10 @@ def solve(trial: str = "1a", out=sys.stderr, measured=None, progress=None):
     args = three_mass.mbi_arguments(tr)
     if measured is not None:
         args["true"] = measured
-    res = identify(**args, Wz=None if measured is not None else tr.Wz, out=out, progress=progress)
+    # the identified K is one of many controllers that meet the bound: on this rig the
+    # LMI controllers read closer to the hidden dynamics (trial 5: 15 % from D_u against 57 %)
+    res = identify(**args, Wz=None if measured is not None else tr.Wz, out=out, progress=progress,
+                   dk_options={"synthesis": "lmi-first"})
     band = res.fit.omega
     return {
         "trial": tr.name,
