@@ -209,26 +209,13 @@ def test_freqresp_stiff_closed_loop_matches_direct_solve():
 
 
 def test_freqresp_stiff_closed_loop_matches_mpmath():
-    mp = pytest.importorskip("mpmath")
+    pytest.importorskip("mpmath")
     CL = _stiff_closed_loop()
-    A, B, C, D = (np.asarray(X, float) for X in (CL.A, CL.B, CL.C, CL.D))
-    n = A.shape[0]
     w = [0.0, 1e-6, 1e-2, 1.0, 1e3, 1e7]
     G = freqresp(CL, w)
-    with mp.workdps(40):
-        Am, Bm, Cm = mp.matrix(A.tolist()), mp.matrix(B.tolist()), mp.matrix(C.tolist())
-        for k, wk in enumerate(w):
-            M = -Am
-            for i in range(n):
-                M[i, i] += mp.mpc(0, wk)
-            X = mp.matrix(n, B.shape[1])
-            for j in range(B.shape[1]):
-                x = mp.lu_solve(M, Bm[:, j])
-                for i in range(n):
-                    X[i, j] = x[i]
-            Y = Cm * X
-            R = np.array([[complex(Y[i, j]) for j in range(Y.cols)] for i in range(Y.rows)]) + D
-            assert np.linalg.norm(G[:, :, k] - R) <= 1e-6 * np.linalg.norm(R), wk
+    ref = _mp_response(CL, w)
+    for k, wk in enumerate(w):
+        assert np.linalg.norm(G[:, :, k] - ref[:, :, k]) <= 1e-6 * np.linalg.norm(ref[:, :, k]), wk
 
 
 @pytest.mark.parametrize("seed", range(10))
@@ -265,17 +252,23 @@ def test_hinf_norm_slow_stable_pole_beside_fast_one_is_not_on_axis():
     assert nrm.value == pytest.approx(ct.norm(G, "inf"), rel=1e-6)
 
 
+def _hidden_axis_poles(rng):
+    """A with an integrator and an undamped mode at 3 rad/s beside poles at -1e-6 and -1e8,
+    mixed by a random similarity T drawn from ``rng``.  Returns ``(A, A0, T)``, ``A = T^-1 A0 T``."""
+    A0 = np.zeros((5, 5))
+    A0[1:3, 1:3] = [[0.0, 3.0], [-3.0, 0.0]]
+    A0[3, 3], A0[4, 4] = -1e-6, -1e8
+    T = rng.standard_normal((5, 5)) + 3 * np.eye(5)
+    return np.linalg.solve(T, A0 @ T), A0, T
+
+
 @pytest.mark.parametrize("seed", range(5))
 def test_hinf_norm_true_axis_poles_found_in_stiff_systems(seed):
     """An integrator and an undamped mode at 3 rad/s hidden by a random similarity in a
     system with poles at -1e-6 and -1e8: computed real parts are rounding noise of
     size eps ||A||, so the axis test must use the pole's own error, not just its size."""
     rng = np.random.default_rng(seed)
-    A0 = np.zeros((5, 5))
-    A0[1:3, 1:3] = [[0.0, 3.0], [-3.0, 0.0]]
-    A0[3, 3], A0[4, 4] = -1e-6, -1e8
-    T = rng.standard_normal((5, 5)) + 3 * np.eye(5)
-    A = np.linalg.solve(T, A0 @ T)
+    A, A0, T = _hidden_axis_poles(rng)
     B, C = rng.standard_normal((5, 2)), rng.standard_normal((2, 5))
     assert hinf_norm(ss(A, B, C, np.zeros((2, 2)))).value == np.inf
     # without the integrator and the undamped mode (same fast and slow poles) it is finite
@@ -314,12 +307,7 @@ def test_stability_integrator_hidden_in_stiff_system_is_not_called_stable():
     from mutext.lti import is_stable, stability
     raw_said_stable = 0
     for seed in range(8):
-        rng = np.random.default_rng(seed)
-        A0 = np.zeros((5, 5))
-        A0[1:3, 1:3] = [[0.0, 3.0], [-3.0, 0.0]]
-        A0[3, 3], A0[4, 4] = -1e-6, -1e8
-        T = rng.standard_normal((5, 5)) + 3 * np.eye(5)
-        A = np.linalg.solve(T, A0 @ T)
+        A = _hidden_axis_poles(np.random.default_rng(seed))[0]
         G = ss(A, np.ones((5, 1)), np.ones((1, 5)), [[0.0]])
         raw_said_stable += bool(np.all(np.linalg.eigvals(A).real < 0))
         st = stability(G)

@@ -87,7 +87,7 @@ def main(argv) -> int:
         print(json.dumps(results, indent=2))
     elif not args.json:
         print(report.text())
-    return NOT_ISOLATED if args.require_isolation and report.isolation not in ("uid", "landlock") else 0
+    return NOT_ISOLATED if args.require_isolation and not report.isolated else 0
 
 
 def _batch(args) -> int:

@@ -85,6 +85,11 @@ class Report:
     isolation_details: list = field(default_factory=list)
 
     @property
+    def isolated(self) -> bool:
+        """The submission ran confined (``uid`` or ``landlock``)."""
+        return self.isolation in ("uid", "landlock")
+
+    @property
     def isolation_text(self) -> str:
         """One line saying how the submission was isolated (or that it was not)."""
         if self.isolation == "none":
