@@ -48,16 +48,22 @@ poles and zeros in the left half plane.
 
 Real parameters are treated as complex scalars in the iteration (D scalings
 only, as in the classical ``dksyn``).  D-G-K iteration (``musyn``; Young 1996)
-would keep their G scalings: at level :math:`\beta` the D-G bound reads
-:math:`\|(\tilde M - j\tilde G)(I+\tilde G^2)^{-1/2}\| \le 1` with
-:math:`\tilde M = DMD^{-1}/\beta`, :math:`\tilde G = D^{-1}GD^{-1}/\beta`,
-and the K step would need a stable rational fit of :math:`j\tilde G(\omega)`.
-It is not implemented: a prototype on the two-mass problem (pointwise D-G
-scalings smoothed along the grid, :math:`\hat G` by least squares on fixed
-real poles) gave controllers at 1.04-1.05 against 1.016 with the complex
-treatment, because no stable real-rational :math:`\hat G` kept its real part
-small enough; and the pointwise-optimal scalings themselves are not unique
-away from the peak (:math:`\tilde G` up to 1e50 where :math:`D \to 0`).  The best closed loop is then analysed
+would keep their G scalings.  For ``1 x 1`` real blocks these are discs:
+:func:`mutext.mu.dg_disc` turns the D-G bound into the equivalent complex
+problem, the disc centres :math:`jb_k(\omega)/\beta` closed as a feedback around
+the real channels, and a K step would need stable rational filters for them.
+It is not implemented.  :math:`b_k` is odd in :math:`\omega` (so :math:`jb_k`
+acts like a differentiator, and a stable filter adds a real part that widens
+the disc) and not unique away from the peak.  Two prototypes on the two-mass
+problem at 0.041 m (K steps on the disc form with fitted centres; the "mu-K"
+shrinkage of the real channels) gave D-G bounds of 1.09-1.17 against the
+complex treatment's 1.016-1.019.  There, and at 0.035 m and on the three-mass
+trial 5, the D-G bound of the D-K controller equals the complex bound at the
+peak (for the two-mass problem at low frequency, where the loop is nearly
+real), so treating the parameters as real gains nothing there unless the
+controller changes.
+
+After the iteration the best closed loop is analysed
 with the optimal, unfitted scalings on a fine grid whose peaks are refined
 (every value is :math:`\bar\sigma(DMD^{-1})` for an explicit :math:`D`, a
 certified bound at that frequency), with lower bounds at the peaks

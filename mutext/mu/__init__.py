@@ -113,6 +113,9 @@ The implementation is split along these ideas; import everything from
     The D-G bound by quasi-Newton descent (``method="fast"``).
 ``_upper``
     :func:`mu_upper`, which dispatches to the three methods.
+``_disc``
+    :func:`dg_disc`: the D-G bound as an equivalent complex problem (each
+    real parameter's interval replaced by a disc), the form a D-G-K step needs.
 ``_lower``
     :class:`MuLower` and :func:`mu_lower`: power iteration, real and mixed searches.
 ``_bounds``
@@ -145,6 +148,7 @@ from __future__ import annotations
 
 from ._bounds import MuBounds, mu_bounds
 from ._certificate import MuUpper, dg_bound, scaled_sigma
+from ._disc import DiscForm, dg_disc, disc_transform
 from ._lmi import _LMIProblem  # noqa: F401  (tests patch the LMI solver through mutext.mu)
 from ._lower import MuLower, mu_lower
 from ._structure import Block, BlockStructure
@@ -153,4 +157,4 @@ from ._upper import mu_upper
 
 __all__ = ["Block", "BlockStructure", "MuUpper", "MuLower", "MuBounds", "MuSweep",
            "mu_upper", "mu_lower", "mu_bounds", "mu_sweep", "default_grid", "scaled_sigma",
-           "dg_bound"]
+           "dg_bound", "DiscForm", "dg_disc", "disc_transform"]
