@@ -98,6 +98,16 @@ class _DGParams:
         return m
 
     # -- the bound and its gradient -------------------------------------------
+    @staticmethod
+    def _top(A, GA):
+        """Largest eigenvalue of H = A^H A + j(GA - (GA)^H) (no G term if ``GA`` is None) and its
+        eigenvector: the congruent form whose eigenvalue is the squared bound."""
+        H = A.conj().T @ A
+        if GA is not None:
+            H = H + 1j * (GA - GA.conj().T)
+        ev, V = np.linalg.eigh(H)
+        return float(ev[-1]), V[:, -1]
+
     def value_grad(self, x, M, beta0, grad: bool = True):
         r"""(lambda, grad log lambda) with :math:`\lambda = \lambda_{\max}(H)` (the squared bound)."""
         S = self.S
@@ -106,18 +116,15 @@ class _DGParams:
             m = self.m
             e = np.exp(x[:m])
             A = e[S.col_block][:, None] * M / e[S.row_block][None, :]
-            H = A.conj().T @ A
+            GA = None
             if self.nreal:
                 gs = np.sinh(x[m:])
                 # G A: G maps column gcol of A (z of the real block) to row grow (its w)
                 GA = np.zeros((S.nrows, S.nrows), complex)
                 GA[self.grow] = (beta0 * gs)[:, None] * A[self.gcol]
-                H = H + 1j * (GA - GA.conj().T)
-            ev, V = np.linalg.eigh(H)
-            lam = float(ev[-1])
+            lam, v = self._top(A, GA)
             if not grad:
                 return lam, None
-            v = V[:, -1]
             a = A @ v
             g = np.empty(self.size)
             g[:m] = 2.0 * ((a.real ** 2 + a.imag ** 2) @ self.El - lam * ((v.real ** 2 + v.imag ** 2) @ self.Er))
@@ -148,15 +155,9 @@ class _DGParams:
                 Gh[rs, cs] = beta0 * Gk
             Ghs.append(Gk)
         A = Lc.conj().T @ M @ Lri.conj().T
-        H = A.conj().T @ A
-        if Gh is not None:
-            GA = Gh @ A
-            H = H + 1j * (GA - GA.conj().T)
-        ev, V = np.linalg.eigh(H)
-        lam = float(ev[-1])
+        lam, v = self._top(A, None if Gh is None else Gh @ A)
         if not grad:
             return lam, None
-        v = V[:, -1]
         a = A @ v
         u = Lri.conj().T @ v
         z = M @ u
