@@ -57,9 +57,9 @@ acts like a differentiator, and a stable filter adds a real part that widens
 the disc) and not unique away from the peak.  Three prototypes on the
 two-mass problem at 0.041 m (K steps on the disc form with fitted centres; the
 "mu-K" shrinkage of the real channels; Young's affine form with para-skew G
-filters made causal by an all-pass, exact on the axis) gave D-G bounds of
-1.03-1.29 against the complex treatment's 1.016-1.019 (the book's mu chapter
-has the details).  There, and at 0.035 m and on the three-mass
+filters made causal by an all-pass, exact on the axis) and variants gave D-G
+bounds of 1.02-1.49, against 1.0147-1.019 for complex D-K (the book's mu
+chapter has the details).  There, and at 0.035 m and on the three-mass
 trial 5, the D-G bound of the D-K controller equals the complex bound at the
 peak (for the two-mass problem at low frequency, where the loop is nearly
 real), so treating the parameters as real gains nothing there unless the
