@@ -9,16 +9,13 @@ import numpy as np
 import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
+from mu_cases import ab13md_structure, crandn
 
 from mutext import mu as mumod
 from mutext.errors import ModelError, SolverError
 from mutext.lti import freqresp, ss
 from mutext.mu import (Block, BlockStructure, dg_bound, mu_bounds, mu_lower, mu_sweep,
                        mu_upper, scaled_sigma)
-
-
-def crandn(rng, *shape):
-    return rng.standard_normal(shape) + 1j * rng.standard_normal(shape)
 
 
 def check_lower(M, S, lo, rtol=1e-9):
@@ -551,21 +548,7 @@ def test_sweep_bad_input():
 def _ab13md_case(rng, nblocks):
     """A random structure of the kinds AB13MD takes (1 x 1 real, square full complex) and its
     arguments for slycot.ab13md."""
-    blocks, nb, it = [], [], []
-    for kind in rng.choice(["real", "c1", "full2"], size=nblocks):
-        if kind == "real":
-            blocks.append(Block.real())
-            nb.append(1)
-            it.append(1)
-        elif kind == "c1":
-            blocks.append(Block.full(1))
-            nb.append(1)
-            it.append(2)
-        else:
-            blocks.append(Block.full(2))
-            nb.append(2)
-            it.append(2)
-    return BlockStructure(blocks), np.array(nb), np.array(it)
+    return ab13md_structure(rng.choice(["real", "c1", "full2"], size=nblocks))
 
 
 @pytest.mark.parametrize("seed", range(12))

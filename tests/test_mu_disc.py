@@ -3,28 +3,22 @@ both the mixed bound of M and the complex bound of the disc form, and the determ
 the substitution rests on, checked by dense algebra."""
 import numpy as np
 import pytest
+from mu_cases import ab13md_structure, crandn
 
 from mutext.errors import ModelError
 from mutext.mu import Block, BlockStructure, dg_disc, disc_transform, mu_upper
 
 
-def crandn(rng, *shape):
-    return rng.standard_normal(shape) + 1j * rng.standard_normal(shape)
-
-
-def _case(rng, nreal):
+def _case(nreal):
     """Real 1 x 1 blocks, a complex scalar and a full 2 x 2 block, with AB13MD's arguments."""
-    blocks = [Block.real() for _ in range(nreal)] + [Block.full(1), Block.full(2)]
-    nb = np.array([1] * nreal + [1, 2])
-    it = np.array([1] * nreal + [2, 2])
-    return BlockStructure(blocks), nb, it
+    return ab13md_structure(["real"] * nreal + ["c1", "full2"])
 
 
 @pytest.mark.parametrize("seed", range(10))
 def test_disc_form_equals_the_mixed_bound_by_ab13md(seed):
     ab13md = pytest.importorskip("slycot").ab13md
     rng = np.random.default_rng(300 + seed)
-    S, nb, it = _case(rng, 1 + seed % 3)
+    S, nb, it = _case(1 + seed % 3)
     M = crandn(rng, S.ncols, S.nrows)
     if seed % 2 == 0:
         M = M.real + 0.2j * M.imag               # nearly real: G matters most
@@ -42,7 +36,7 @@ def test_disc_form_equals_the_mixed_bound_by_ab13md(seed):
 @pytest.mark.parametrize("seed", range(4))
 def test_higher_levels_are_certified_too(seed):
     rng = np.random.default_rng(seed)
-    S, _, _ = _case(rng, 2)
+    S, _, _ = _case(2)
     M = crandn(rng, S.ncols, S.nrows)
     up = mu_upper(M, S, method="fast")
     for factor in (1.0, 1.1, 2.0):
@@ -56,7 +50,7 @@ def test_substitution_determinant_identity(seed):
     on the real blocks and Delta_c / beta on the complex ones; and every real delta in
     [-1/beta, 1/beta] has its disc coordinate inside the unit disc."""
     rng = np.random.default_rng(50 + seed)
-    S, _, _ = _case(rng, 2)
+    S, _, _ = _case(2)
     M = crandn(rng, S.ncols, S.nrows)
     form = dg_disc(M, S)
     beta, b, rho = form.level, form.centres, form.radii
@@ -84,7 +78,7 @@ def test_substitution_determinant_identity(seed):
 
 def test_grid_and_errors():
     rng = np.random.default_rng(1)
-    S, _, _ = _case(rng, 1)
+    S, _, _ = _case(1)
     H = crandn(rng, 5, S.ncols, S.nrows)
     out = disc_transform(H, S, 0.3j, 1.2, 2.0)
     assert out.shape == H.shape

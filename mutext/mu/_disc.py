@@ -174,7 +174,7 @@ def dg_disc(M, structure, *, upper: MuUpper | None = None, level: float | None =
     """
     from ._upper import mu_upper
     S = _as_structure(structure)
-    real, rows, _ = _real_channels(S)
+    _, rows, _ = _real_channels(S)
     A = S.check(M)
     if upper is None:
         upper = mu_upper(A, S, method="fast")
