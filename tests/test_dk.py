@@ -261,6 +261,20 @@ def test_two_mass_mu_json_keys(capsys):
     assert "gamma (K step)" in captured.err           # progress on stderr
 
 
+@pytest.mark.slow
+def test_two_mass_mu_real_parameters(capsys):
+    """``--real``: D-G-K; the tries are reported and the controller kept is the best of them by
+    the D-G bound; the corners of the parameter box (rebuilt from M and K) stay stable."""
+    assert cli.main(["demo", "two-mass-mu", "--xmax", "0.041", "--real", "--json"]) == 0
+    captured = capsys.readouterr()
+    out = json.loads(captured.out)
+    assert len(out["tries"]) >= 2 and out["tries"][0]["scale"] == 1.0
+    assert out["mu_upper_dg"] == min(t["mu_dg"] for t in out["tries"])
+    assert out["mu_upper_dg"] < out["tries"][0]["mu_dg"]
+    assert out["nominal_stable"] and out["corners_stable"]
+    assert "D-G-K try 2/6" in captured.err
+
+
 def test_two_mass_mu_bad_xmax(capsys):
     assert cli.main(["demo", "two-mass-mu", "--xmax", "-1"]) == 1
     assert "--xmax" in capsys.readouterr().err
