@@ -33,16 +33,17 @@ TWO_MASS_KINDS = ["real"] * 4 + ["full2"]
 @pytest.fixture(scope="module")
 def two_mass_dgk():
     P = tmu.plant(0.041)
-    buf = io.StringIO()
-    res = dgk_iteration(P, tmu.structure(), 1, 1, max_tries=2, out=buf)
-    return P, res, buf.getvalue()
+    buf, calls = io.StringIO(), []
+    res = dgk_iteration(P, tmu.structure(), 1, 1, max_tries=2, out=buf,
+                        progress=lambda stage, frac: calls.append((stage, frac)))
+    return P, res, buf.getvalue(), calls
 
 
 def test_dgk_beats_complex_dk_on_the_loop_as_given(two_mass_dgk):
     """Two-mass problem at 0.041 m: with the parameters' ranges at 0.97 in the K steps, the D-G
     bound of the true loop (AB13MD) is below plain D-K's with the same options (1.0157 against
     1.0187 when written), and the controller is no larger."""
-    P, res, _ = two_mass_dgk
+    P, res, _, _ = two_mass_dgk
     assert [t["scale"] for t in res.tries] == [1.0, 0.97]
     plain = res.tries[0]
     assert res.real_scale == 0.97
@@ -59,7 +60,7 @@ def test_dgk_beats_complex_dk_on_the_loop_as_given(two_mass_dgk):
 def test_dgk_reported_bound_is_the_ab13md_bound(two_mass_dgk):
     """The reported D-G peak is that of AB13MD on the same grid (to 1e-4), not the complex
     value of a flat stretch of the bound (the D-G bound has to be evaluated there too)."""
-    P, res, _ = two_mass_dgk
+    P, res, _, _ = two_mass_dgk
     CL = ct.ss(P).lft(ct.ss(res.K), nu=1, ny=1)
     ref = _ab13md_sweep(CL, res.sweep.omega, TWO_MASS_KINDS)
     assert res.mu_upper_dg == pytest.approx(ref.max(), rel=1e-4)
@@ -67,12 +68,17 @@ def test_dgk_reported_bound_is_the_ab13md_bound(two_mass_dgk):
 
 
 def test_dgk_prints_each_try_and_notes_the_choice(two_mass_dgk):
-    _, res, text = two_mass_dgk
+    _, res, text, calls = two_mass_dgk
     assert "D-G-K try 1/2: the K steps see the real parameters over 1.0000 x their range" in text
     assert "D-G-K try 2/2: the K steps see the real parameters over 0.9700 x their range" in text
     assert "D-G-K best: c = 0.9700" in text
     assert text.count("gamma (K step)") == 2          # each try's iteration table
     assert any(n.startswith("D-G-K: 2 D-K runs") for n in res.notes)
+    # progress: each try's K steps and final analysis, within its share of the bar, in order
+    assert any(st.startswith("D-G-K try 1/2 (c = 1.000): K-step") for st, _ in calls)
+    assert any(st.startswith("D-G-K try 2/2 (c = 0.970): final-analysis") for st, _ in calls)
+    fr = [f for _, f in calls]
+    assert all(0.0 <= f <= 1.0 for f in fr) and fr == sorted(fr) and fr[-1] == 1.0
 
 
 def test_real_scaled_plant_shrinks_the_parameter_ranges():
