@@ -476,7 +476,9 @@ class DKResult:
         down, capped pointwise by the complex bound; equal to ``mu`` without
         real blocks or with ``dg=False``), ``orders`` (D-fit orders used in
         that K step), ``g_orders`` (G-fit orders of the real blocks: None,
-        the iteration scales real blocks as complex), ``plant_states``
+        the K steps scale real blocks as complex), ``real_scale`` (the
+        factor on the real parameters' ranges in the K step: 1, or the try's
+        :math:`c` in :func:`dgk_iteration`), ``plant_states``
         (states of the scaled K-step plant), ``fit_peak`` (peak of the
         fitted-scaled closed loop of the previous controller, the level the K
         step starts from), ``controller_order``, ``method`` (how the K step's
@@ -786,10 +788,11 @@ def dk_iteration(P, structure: BlockStructure, nmeas: int, ncon: int, *, omega=N
     out : file or None
         Where the per-iteration table is printed (default None: silent; the demos pass sys.stderr).
         Columns: iteration, K-step level, peak mu on the grid (and with real
-        blocks its D-G bound), the D-fit orders (and G-fit orders with real
-        blocks: "-", the K steps scale real blocks as complex) of the scalings
-        used in that K step, controller order, states of the scaled plant and
-        seconds.
+        blocks its D-G bound), the D-fit orders of the scalings used in
+        that K step (and, with real blocks, how the K step saw them:
+        "complex", or "c = ..." for the scaled ranges of a
+        :func:`dgk_iteration` try), controller order, states of the scaled
+        plant and seconds.
     progress : callable, optional
         ``progress(stage, fraction)``, called during the slow steps (e.g.
         :class:`mutext.progress.ProgressLine`): the K step (``"K-step ..."``;
@@ -907,7 +910,8 @@ class _Heartbeat:
 
 
 def _dk(P, S, nmeas, ncon, grid, max_iter, max_order, budget, fit_tol, rel_improvement, patience,
-        grid_points, final_points, dg, synth, out, t0, on_progress=None, as_given=None):
+        grid_points, final_points, dg, synth, out, t0, on_progress=None, as_given=None,
+        real_scale: float = 1.0):
     """The iteration on ``P``; the best controller's final analysis on the loop of ``as_given``
     (default ``P``), the plant :func:`dgk_iteration` judges every try on."""
     Sc = S.complexified()
@@ -931,7 +935,8 @@ def _dk(P, S, nmeas, ncon, grid, max_iter, max_order, budget, fit_tol, rel_impro
         return _d_step(grid, H, S, X, upper, order, fit_tol, budget,
                        progress=lambda text: report(f"D-fit {it}/{max_iter}: {text}", at(it, 0.9)))
     real_blocks = [k for k, b in enumerate(S.blocks) if b.kind == "real"]
-    gcol = f" {'G-fit orders':>13}" if real_blocks else ""
+    gcol = f" {'real blocks':>11}" if real_blocks else ""
+    gtxt = (f" {'complex' if real_scale == 1.0 else f'c = {real_scale:.3f}':>11}" if real_blocks else "")
     dgcol = f" {'mu D-G':>8}" if real_blocks and dg else ""
     Xd = None          # log D scalings on the grid, the next sweep's starting point
     fits = [None] * len(S)
@@ -965,8 +970,8 @@ def _dk(P, S, nmeas, ncon, grid, max_iter, max_order, budget, fit_tol, rel_impro
             notes.append(f"iteration {it}: the K step failed ({exc}); kept iteration {best[4]}")
             history.append({"iteration": it, "gamma": float("nan"), "mu": float("nan"),
                             "mu_dg": float("nan"), "orders": orders,
-                            "g_orders": [None] * len(real_blocks), "plant_states": int(PD.nstates),
-                            "fit_peak": fit_peak, "controller_order": None,
+                            "g_orders": [None] * len(real_blocks), "real_scale": real_scale,
+                            "plant_states": int(PD.nstates), "fit_peak": fit_peak, "controller_order": None,
                             "method": None, "seconds": time.perf_counter() - ti, "error": str(exc)})
             msg = str(exc)
             _print(out, f"{it:>4}  K step failed: {msg[:90] + ' ...' if len(msg) > 90 else msg}")
@@ -994,8 +999,8 @@ def _dk(P, S, nmeas, ncon, grid, max_iter, max_order, budget, fit_tol, rel_impro
             report(f"mu-sweep {it}/{max_iter}: D-G bound at the peaks", at(it, 0.9))
             mu_dg_pk = _dg_peak(H, S, upper)
         row = {"iteration": it, "gamma": float(res.gamma), "mu": mu_pk, "mu_dg": mu_dg_pk, "orders": orders,
-               "g_orders": [None] * len(real_blocks), "plant_states": int(PD.nstates),
-               "fit_peak": fit_peak, "controller_order": int(K.nstates),
+               "g_orders": [None] * len(real_blocks), "real_scale": real_scale,
+               "plant_states": int(PD.nstates), "fit_peak": fit_peak, "controller_order": int(K.nstates),
                "method": getattr(res, "method", "custom"),
                "seconds": time.perf_counter() - ti}
         history.append(row)
@@ -1015,7 +1020,6 @@ def _dk(P, S, nmeas, ncon, grid, max_iter, max_order, budget, fit_tol, rel_impro
             else:
                 fits = fits_new
         row["seconds"] = time.perf_counter() - ti
-        gtxt = f" {'-':>13}" if real_blocks else ""
         dgtxt = f" {mu_dg_pk:>8.5f}" if dgcol else ""
         _print(out, f"{it:>4} {res.gamma:>15.5f} {mu_pk:>10.5f}{dgtxt} {str(orders):>18}{gtxt} {K.nstates:>8} "
                     f"{PD.nstates:>6} {row['seconds']:>8.2f}")
@@ -1185,7 +1189,7 @@ def dgk_iteration(P, structure: BlockStructure, nmeas: int, ncon: int, *, step: 
         ti = time.perf_counter()
         Pc = P if c == 1.0 else real_scaled_plant(P, S, c, nmeas, ncon)
         with blas_single_thread():
-            r = _dk(Pc, S, nmeas, ncon, *args, out, ti, rep, as_given=P)
+            r = _dk(Pc, S, nmeas, ncon, *args, out, ti, rep, as_given=P, real_scale=c)
         r.real_scale = c
         results[c] = r
         _print(out, f"D-G-K try {i}: loop of the plant as given: mu <= {r.mu_upper_dg:.5f} (D-G), "

@@ -29,7 +29,7 @@ def add_arguments(p):
     p.add_argument("--max-iter", type=int, default=6, help="largest number of D-K iterations (default 6)")
     p.add_argument("--real", action="store_true",
                    help="keep the parameters real in the design (D-G-K: up to six D-K runs with the "
-                        "parameters' ranges scaled in the K steps, judged by the D-G bound; about 30 s)")
+                        "parameters' ranges scaled in the K steps, judged by the D-G bound; under a minute)")
 
 
 def check_controller(K, x_max: float, rel: float = 0.02) -> dict:
