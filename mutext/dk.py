@@ -685,20 +685,23 @@ def _fine_sweep(CL, S: BlockStructure, omega, npeaks: int = 4, rounds: int = 3, 
                    float("nan"), float("nan"), None, ["osborne"] * w.size)
 
 
-def _dg_peak(H, S: BlockStructure, upper) -> float:
+def _dg_peak(H, S: BlockStructure, upper) -> tuple[float, int]:
     """Peak over the grid of min(D-G bound, complex bound ``upper``), both certified at each
     frequency.  The D-G bound (``mutext.mu.mu_upper(method="fast")``) is computed from the
     largest complex values down, until the next complex value cannot raise the peak.  Where
     the complex bound is flat (an equalised D-K loop) that is every frequency of the flat
     part: stopping earlier would report the complex value of a frequency whose D-G bound is
-    lower, and miss the gain of a controller that exploits the real parameters."""
+    lower, and miss the gain of a controller that exploits the real parameters.
+    Returns the peak and its index in the grid."""
     order = np.argsort(-np.asarray(upper))
-    best = 0.0
+    best, at = 0.0, int(order[0])
     for k in order:
         if upper[k] <= best:
             break
-        best = max(best, min(mu_upper(H[k], S, method="fast").value, float(upper[k])))
-    return float(best)
+        v = min(mu_upper(H[k], S, method="fast").value, float(upper[k]))
+        if v > best:
+            best, at = v, int(k)
+    return float(best), at
 
 
 def _final_analysis(CL, S: BlockStructure, grid, final_points: int, dg: bool, npeaks: int = 4,
@@ -709,20 +712,24 @@ def _final_analysis(CL, S: BlockStructure, grid, final_points: int, dg: bool, np
     fine = np.unique(np.concatenate([default_grid(CL, n=final_points, decades=1.5), grid]))
     final = _fine_sweep(CL, Sc, fine, npeaks=npeaks,
                         progress=lambda f: report(f"final-analysis: mu sweep, {fine.size} frequencies", 0.4 * f))
-    report("final-analysis: lower bounds at the peaks", 0.4)
     ups = final.upper
     wpk = final.omega[_local_maxima(ups, npeaks)]
+    mu_dg = float(final.peak_upper)
+    wreal = wpk
+    if S.has_real and dg:
+        report("final-analysis: D-G bound", 0.4)
+        mu_dg, k = _dg_peak(np.moveaxis(freqresp(CL, final.omega), -1, 0), S, ups)
+        # the real lower bound also where the D-G bound peaks: a loop that uses the
+        # parameters' realness has its complex peaks elsewhere
+        wreal = np.union1d(wpk, final.omega[k:k + 1])
+    report("final-analysis: lower bounds at the peaks", 0.7)
     low_c = mu_sweep(CL, Sc, wpk, method="osborne", lower="all", refine=False)
-    low = mu_sweep(CL, S, wpk, method="osborne", lower="all", refine=False) if S.has_real else low_c
+    low = mu_sweep(CL, S, wreal, method="osborne", lower="all", refine=False) if S.has_real else low_c
     final.lower = np.full(final.omega.size, np.nan)
     final.lower[np.searchsorted(final.omega, low.omega)] = low.lower
     final.peak_lower = float(low.peak_lower)
     final.lower_frequency = float(low.lower_frequency)
     final.lower_delta = low.lower_delta
-    mu_dg = float(final.peak_upper)
-    if S.has_real and dg:
-        report("final-analysis: D-G bound", 0.7)
-        mu_dg = _dg_peak(np.moveaxis(freqresp(CL, final.omega), -1, 0), S, ups)
     return final, float(low.peak_lower), float(low_c.peak_lower), mu_dg
 
 
@@ -997,7 +1004,7 @@ def _dk(P, S, nmeas, ncon, grid, max_iter, max_order, budget, fit_tol, rel_impro
             # the bound with the real blocks real (fast D-G sweep, no LMI check), pointwise
             # no higher than the complex one: both are certified at each frequency
             report(f"mu-sweep {it}/{max_iter}: D-G bound at the peaks", at(it, 0.9))
-            mu_dg_pk = _dg_peak(H, S, upper)
+            mu_dg_pk = _dg_peak(H, S, upper)[0]
         row = {"iteration": it, "gamma": float(res.gamma), "mu": mu_pk, "mu_dg": mu_dg_pk, "orders": orders,
                "g_orders": [None] * len(real_blocks), "real_scale": real_scale,
                "plant_states": int(PD.nstates), "fit_peak": fit_peak, "controller_order": int(K.nstates),
