@@ -1185,18 +1185,25 @@ def dgk_iteration(P, structure: BlockStructure, nmeas: int, ncon: int, *, step: 
         raise ModelError(f"max_tries must be an integer >= 2, got {max_tries!r}")
     grid = args[0] if args[0] is not None else _default_dk_grid(P, kw["grid_points"])
     args = (grid,) + args[1:]
-    results = {}
+    results, failed = {}, []
 
     def run(c):
-        i = len(results) + 1
+        i = tried() + 1
         _print(out, f"D-G-K try {i}/{max_tries}: the K steps see the real parameters over {c:.4f} x their range")
         rep = None if progress is None else (
             lambda stage, f: progress(f"D-G-K try {i}/{max_tries} (c = {c:.3f}): {stage}",
                                       min(1.0, (i - 1 + f) / max_tries)))
         ti = time.perf_counter()
         Pc = P if c == 1.0 else real_scaled_plant(P, S, c, nmeas, ncon)
-        with blas_single_thread():
-            r = _dk(Pc, S, nmeas, ncon, *args, out, ti, rep, as_given=P, real_scale=c)
+        try:
+            with blas_single_thread():
+                r = _dk(Pc, S, nmeas, ncon, *args, out, ti, rep, as_given=P, real_scale=c)
+        except (InfeasibleError, SolverError, IllPosedError) as exc:
+            if c == 1.0:
+                raise
+            failed.append(f"c = {c:.4f}: {str(exc)[:120]}")
+            _print(out, f"D-G-K try {i}: the D-K run failed ({str(exc)[:90]})")
+            return np.inf
         r.real_scale = c
         results[c] = r
         _print(out, f"D-G-K try {i}: loop of the plant as given: mu <= {r.mu_upper_dg:.5f} (D-G), "
@@ -1208,20 +1215,23 @@ def dgk_iteration(P, structure: BlockStructure, nmeas: int, ncon: int, *, step: 
         c = float(round(c, 6))
         return results[c].mu_upper_dg if c in results else run(c)
 
+    def tried():
+        return len(results) + len(failed)
+
     v1 = value(1.0)
     c = 1.0 - step
     if value(c) < v1:
-        while len(results) < max_tries - 1 and c - step > 0.0:
+        while tried() < max_tries - 1 and c - step > 0.0:
             if value(c - step) >= value(c):
                 break
             c -= step
-    elif len(results) < max_tries:
+    elif tried() < max_tries:
         value(1.0 - step / 2)
     # one parabolic step through the best try and its neighbours
     cs = sorted(results)
     best = min(cs, key=lambda x: results[x].mu_upper_dg)
     k = cs.index(best)
-    if len(results) < max_tries and 0 < k < len(cs) - 1:
+    if tried() < max_tries and 0 < k < len(cs) - 1:
         (a, fa), (b, fb), (d, fd) = [(x, results[x].mu_upper_dg) for x in cs[k - 1:k + 2]]
         den = (b - a) * (fb - fd) - (b - d) * (fb - fa)
         if den != 0.0:
@@ -1235,6 +1245,8 @@ def dgk_iteration(P, structure: BlockStructure, nmeas: int, ncon: int, *, step: 
                 "iterations": len(results[c].history), "seconds": results[c].seconds}
                for c in results]
     r.seconds = time.perf_counter() - t0
+    if failed:
+        r.notes.append("D-G-K: failed tries (" + "; ".join(failed) + ")")
     r.notes.append(f"D-G-K: {len(results)} D-K runs with the real parameters' ranges scaled by "
                    + ", ".join(f"{c:.4f}" for c in results) + f"; the best, {best:.4f}, gives the loop of "
                    f"the plant as given mu <= {r.mu_upper_dg:.5f} with D-G scalings (plain D-K: {v1:.5f})")

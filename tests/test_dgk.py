@@ -111,6 +111,23 @@ def test_real_scaled_plant_shrinks_the_parameter_ranges():
     assert Pc.nstates == P.nstates
 
 
+def test_dgk_keeps_going_when_a_try_fails():
+    """A try whose K step fails is noted and skipped; plain D-K (the first try) is kept."""
+    from mutext.dk import _k_step
+    from mutext.errors import SolverError
+    calls = []
+
+    def synth(PD, nmeas, ncon):
+        calls.append(PD.nstates)
+        if len(calls) > 1:
+            raise SolverError("K step refused for this test")
+        return _k_step(PD, nmeas, ncon)
+    res = dgk_iteration(tmu.plant(0.041), tmu.structure(), 1, 1, max_iter=1, max_tries=3, synthesis=synth)
+    assert [t["scale"] for t in res.tries] == [1.0] and res.real_scale == 1.0
+    assert any("failed tries (c = 0.9700: K step refused for this test; c = 0.9850" in n for n in res.notes)
+    assert np.linalg.eigvals(ct.ss(tmu.plant(0.041)).lft(ct.ss(res.K), nu=1, ny=1).A).real.max() < 0
+
+
 @pytest.mark.parametrize("kw, match", [
     ({"step": 0.0}, r"step must lie in \(0, 0.5\)"),
     ({"step": 0.6}, r"step must lie in \(0, 0.5\)"),
