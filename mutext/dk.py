@@ -1098,8 +1098,9 @@ def dgk_iteration(P, structure: BlockStructure, nmeas: int, ncon: int, *, step: 
     matters: the D-G bound (real blocks real) of the loop of the plant *as
     given* with the resulting controller.  The tries are :math:`c = 1` (plain
     D-K), then :math:`1 - \text{step}, 1 - 2\,\text{step}, \dots` while the D-G
-    bound falls (:math:`1 - \text{step}/2` if the first step does not help),
-    and one parabolic step between the best and its neighbours.
+    bound falls (if the first step does not help, :math:`1 - \text{step}/2,
+    1 - \text{step}/4, \dots` until one does), and one parabolic step between
+    the best and its neighbours.
 
     The approximation: a K step at :math:`c < 1` optimises a problem in which
     the parameters vary less than they do (the one-dimensional counterpart of
@@ -1225,8 +1226,13 @@ def dgk_iteration(P, structure: BlockStructure, nmeas: int, ncon: int, *, step: 
             if value(c - step) >= value(c):
                 break
             c -= step
-    elif tried() < max_tries:
-        value(1.0 - step / 2)
+    else:
+        # no gain one step away: halve the step towards 1 while tries are left
+        h = step / 2
+        while tried() < max_tries - 1 and h >= step / 16:
+            if value(1.0 - h) < v1:
+                break
+            h /= 2
     # one parabolic step through the best try and its neighbours
     cs = sorted(results)
     best = min(cs, key=lambda x: results[x].mu_upper_dg)
