@@ -1054,7 +1054,8 @@ def _dk(P, S, nmeas, ncon, grid, max_iter, max_order, budget, fit_tol, rel_impro
     return DKResult(K=K, CL=CL, mu_upper=float(final.peak_upper), mu_upper_dg=mu_dg, mu_lower=low,
                     mu_lower_complex=low_c, peak_frequency=float(final.peak_frequency),
                     history=history, sweep=final, fits=used_fits, seconds=time.perf_counter() - t0,
-                    best_iteration=best_it, notes=notes, near_axis_poles=near, max_pole_real=max_re)
+                    best_iteration=best_it, notes=notes, near_axis_poles=near, max_pole_real=max_re,
+                    real_scale=real_scale)
 
 
 # ----------------------------------------------------------------------------
@@ -1168,24 +1169,18 @@ def dgk_iteration(P, structure: BlockStructure, nmeas: int, ncon: int, *, step: 
     if "dg" in options and not options["dg"]:
         raise ModelError("dgk_iteration judges every try by the D-G bound: dg must be True")
     options.pop("dg", None)
-    names = ("omega", "max_iter", "max_order", "max_states", "fit_tol", "rel_improvement", "patience",
-             "grid_points", "final_points", "synthesis")
-    unknown = sorted(set(options) - set(names))
+    # the options of dk_iteration's own signature, less those dgk_iteration takes itself
+    defaults = {k: v for k, v in dk_iteration.__kwdefaults__.items() if k not in ("dg", "out", "progress")}
+    unknown = sorted(set(options) - set(defaults))
     if unknown:
         raise ModelError(f"unknown option(s) for dk_iteration: {', '.join(unknown)}")
-    sig = dk_iteration.__kwdefaults__
-    kw = {n: options.get(n, sig[n]) for n in names}
-    P, S, args = _arguments(P, structure, nmeas, ncon, kw["omega"], kw["max_iter"], kw["max_order"],
-                            kw["max_states"], kw["fit_tol"], kw["rel_improvement"], kw["patience"],
-                            kw["grid_points"], kw["final_points"], True, kw["synthesis"])
+    P, S, args = _arguments(P, structure, nmeas, ncon, dg=True, **{**defaults, **options})
     if not S.has_real:
         raise ModelError(f"the structure {S!r} has no real blocks: use dk_iteration")
     if not (isinstance(step, (int, float, np.floating)) and 0.0 < step < 0.5):
         raise ModelError(f"step must lie in (0, 0.5), got {step!r}")
     if not (isinstance(max_tries, (int, np.integer)) and max_tries >= 2):
         raise ModelError(f"max_tries must be an integer >= 2, got {max_tries!r}")
-    grid = args[0] if args[0] is not None else _default_dk_grid(P, kw["grid_points"])
-    args = (grid,) + args[1:]
     results, failed = {}, []
 
     def run(c):
@@ -1205,7 +1200,6 @@ def dgk_iteration(P, structure: BlockStructure, nmeas: int, ncon: int, *, step: 
             failed.append(f"c = {c:.4f}: {str(exc)[:120]}")
             _print(out, f"D-G-K try {i}: the D-K run failed ({str(exc)[:90]})")
             return np.inf
-        r.real_scale = c
         results[c] = r
         _print(out, f"D-G-K try {i}: loop of the plant as given: mu <= {r.mu_upper_dg:.5f} (D-G), "
                     f"{r.mu_upper:.5f} (complex); controller order {r.K.nstates}; "

@@ -17,3 +17,16 @@ def ab13md_structure(kinds):
     made = [_KINDS[k] for k in kinds]
     return (BlockStructure([make() for make, _, _ in made]), np.array([n for _, n, _ in made]),
             np.array([t for _, _, t in made]))
+
+
+def ab13md_sweep(CL, omega, kinds):
+    """SLICOT AB13MD's upper bound (real blocks real) of a loop at each frequency, independent
+    of mutext: the response by dense complex solves, the structure given by its ``kinds``."""
+    from slycot import ab13md
+    _, nblock, itype = ab13md_structure(kinds)
+    A, B, C, D = (np.asarray(M, float) for M in (CL.A, CL.B, CL.C, CL.D))
+    out = []
+    for w in omega:
+        H = D + C @ np.linalg.solve(1j * w * np.eye(A.shape[0]) - A, B)
+        out.append(ab13md(H.astype(complex), nblock, itype)[0])
+    return np.array(out)

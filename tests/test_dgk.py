@@ -11,20 +11,7 @@ from mutext.errors import ModelError
 from mutext.examples import two_mass_uncertain as tmu
 from mutext.mu import Block, BlockStructure
 
-from mu_cases import ab13md_structure
-
-
-def _ab13md_sweep(CL, omega, kinds):
-    """Mixed mu upper bound (real blocks real) of the loop at each frequency: dense complex
-    solves for the response, SLICOT AB13MD for the bound."""
-    from slycot import ab13md
-    _, nblock, itype = ab13md_structure(kinds)
-    A, B, C, D = (np.asarray(M, float) for M in (CL.A, CL.B, CL.C, CL.D))
-    out = []
-    for w in omega:
-        H = D + C @ np.linalg.solve(1j * w * np.eye(A.shape[0]) - A, B)
-        out.append(ab13md(H.astype(complex), nblock, itype)[0])
-    return np.array(out)
+from mu_cases import ab13md_sweep
 
 
 TWO_MASS_KINDS = ["real"] * 4 + ["full2"]
@@ -36,21 +23,20 @@ def two_mass_dgk():
     buf, calls = io.StringIO(), []
     res = dgk_iteration(P, tmu.structure(), 1, 1, max_tries=2, out=buf,
                         progress=lambda stage, frac: calls.append((stage, frac)))
-    return P, res, buf.getvalue(), calls
+    CL = ct.ss(P).lft(ct.ss(res.K), nu=1, ny=1)
+    return res, CL, ab13md_sweep(CL, res.sweep.omega, TWO_MASS_KINDS), buf.getvalue(), calls
 
 
 def test_dgk_beats_complex_dk_on_the_loop_as_given(two_mass_dgk):
     """Two-mass problem at 0.041 m: with the parameters' ranges at 0.97 in the K steps, the D-G
     bound of the true loop (AB13MD) is below plain D-K's with the same options (1.0157 against
     1.0187 when written), and the controller is no larger."""
-    P, res, _, _ = two_mass_dgk
+    res, CL, ref, _, _ = two_mass_dgk
     assert [t["scale"] for t in res.tries] == [1.0, 0.97]
     plain = res.tries[0]
     assert res.real_scale == 0.97
-    CL = ct.ss(P).lft(ct.ss(res.K), nu=1, ny=1)
     assert np.linalg.eigvals(CL.A).real.max() < 0
     assert res.max_pole_real == pytest.approx(np.linalg.eigvals(CL.A).real.max(), rel=1e-6)
-    ref = _ab13md_sweep(CL, res.sweep.omega, TWO_MASS_KINDS)
     assert ref.max() < 0.999 * plain["mu_dg"]
     assert res.K.nstates <= plain["controller_order"]
     # the real parameters matter for this controller: its complex bound is higher
@@ -60,9 +46,7 @@ def test_dgk_beats_complex_dk_on_the_loop_as_given(two_mass_dgk):
 def test_dgk_reported_bound_is_the_ab13md_bound(two_mass_dgk):
     """The reported D-G peak is that of AB13MD on the same grid (to 1e-4), not the complex
     value of a flat stretch of the bound (the D-G bound has to be evaluated there too)."""
-    P, res, _, _ = two_mass_dgk
-    CL = ct.ss(P).lft(ct.ss(res.K), nu=1, ny=1)
-    ref = _ab13md_sweep(CL, res.sweep.omega, TWO_MASS_KINDS)
+    res, CL, ref, _, _ = two_mass_dgk
     assert res.mu_upper_dg == pytest.approx(ref.max(), rel=1e-4)
     # the real lower bound, taken where the D-G bound peaks (the complex bound peaks
     # elsewhere), meets it: a real perturbation of that size destabilises the loop
@@ -76,7 +60,7 @@ def test_dgk_reported_bound_is_the_ab13md_bound(two_mass_dgk):
 
 
 def test_dgk_prints_each_try_and_notes_the_choice(two_mass_dgk):
-    _, res, text, calls = two_mass_dgk
+    res, _, _, text, calls = two_mass_dgk
     assert "D-G-K try 1/2: the K steps see the real parameters over 1.0000 x their range" in text
     assert "D-G-K try 2/2: the K steps see the real parameters over 0.9700 x their range" in text
     assert "D-G-K best: c = 0.9700" in text
@@ -167,6 +151,6 @@ def test_dgk_default_search_at_both_bounds():
         res = dgk_iteration(P, tmu.structure(), 1, 1, out=None)
         plain = dk_iteration(P, tmu.structure(), 1, 1, out=None)
         CL = ct.ss(P).lft(ct.ss(res.K), nu=1, ny=1)
-        ref = _ab13md_sweep(CL, res.sweep.omega, TWO_MASS_KINDS)
+        ref = ab13md_sweep(CL, res.sweep.omega, TWO_MASS_KINDS)
         assert res.mu_upper_dg == pytest.approx(ref.max(), rel=1e-4)
         assert ref.max() < 0.998 * plain.mu_upper_dg

@@ -6,6 +6,8 @@ import control as ct
 import numpy as np
 import pytest
 
+from mu_cases import ab13md_sweep
+
 from mutext import cli
 from mutext.dk import DScaleFit, dk_iteration, fit_dscale, scaled_plant
 from mutext.errors import ModelError
@@ -323,13 +325,7 @@ DIST_S = BlockStructure([Block.full(1, 1), Block.full(1, 1), Block.full(2, 2)])
 
 def _ab13md_peak(CL, omega):
     """Independent of mutext: dense complex solves for the response, SLICOT AB13MD for mu."""
-    from slycot import ab13md
-    A, B, C, D = (np.asarray(M, float) for M in (CL.A, CL.B, CL.C, CL.D))
-    vals = []
-    for w in omega:
-        H = D + C @ np.linalg.solve(1j * w * np.eye(A.shape[0]) - A, B)
-        vals.append(ab13md(H.astype(complex), np.array([1, 1, 2]), np.array([2, 2, 2]))[0])
-    return float(np.max(vals))
+    return float(np.max(ab13md_sweep(CL, omega, ["c1", "c1", "full2"])))
 
 
 def test_near_axis_poles_are_set_apart():
