@@ -654,10 +654,11 @@ def _local_maxima(values, count):
 
 
 def _fine_sweep(CL, S: BlockStructure, omega, npeaks: int = 4, rounds: int = 3, points: int = 16,
-                progress=None) -> MuSweep:
+                progress=None) -> tuple[MuSweep, np.ndarray]:
     """Diagonal-D upper bound on ``omega`` with its largest local maxima refined:
     ``rounds`` times, ``points`` log-spaced frequencies between the neighbours of
-    each peak are added (each round shrinks the spacing there by ``points + 1``)."""
+    each peak are added (each round shrinks the spacing there by ``points + 1``).
+    Returns the sweep and the loop's response on its grid, (nw, ncols, nrows)."""
     w = np.unique(np.asarray(omega, float))
     H = np.moveaxis(freqresp(CL, w), -1, 0)
     up, X = _sweep_upper(H, S, progress=progress)
@@ -678,11 +679,12 @@ def _fine_sweep(CL, S: BlockStructure, omega, npeaks: int = 4, rounds: int = 3, 
         w = np.concatenate([w, wn])
         up = np.concatenate([up, upn])
         X = np.concatenate([X, Xn])
+        H = np.concatenate([H, Hn])
         order = np.argsort(w)
-        w, up, X = w[order], up[order], X[order]
+        w, up, X, H = w[order], up[order], X[order], H[order]
     k = int(np.argmax(up))
     return MuSweep(w, up, np.full(w.size, np.nan), np.exp(X), "osborne", float(up[k]), float(w[k]),
-                   float("nan"), float("nan"), None, ["osborne"] * w.size)
+                   float("nan"), float("nan"), None, ["osborne"] * w.size), H
 
 
 def _dg_peak(H, S: BlockStructure, upper) -> tuple[float, int]:
@@ -710,7 +712,7 @@ def _final_analysis(CL, S: BlockStructure, grid, final_points: int, dg: bool, np
     report = report or (lambda stage, fraction: None)
     Sc = S.complexified()
     fine = np.unique(np.concatenate([default_grid(CL, n=final_points, decades=1.5), grid]))
-    final = _fine_sweep(CL, Sc, fine, npeaks=npeaks,
+    final, H = _fine_sweep(CL, Sc, fine, npeaks=npeaks,
                         progress=lambda f: report(f"final-analysis: mu sweep, {fine.size} frequencies", 0.4 * f))
     ups = final.upper
     wpk = final.omega[_local_maxima(ups, npeaks)]
@@ -718,7 +720,7 @@ def _final_analysis(CL, S: BlockStructure, grid, final_points: int, dg: bool, np
     wreal = wpk
     if S.has_real and dg:
         report("final-analysis: D-G bound", 0.4)
-        mu_dg, k = _dg_peak(np.moveaxis(freqresp(CL, final.omega), -1, 0), S, ups)
+        mu_dg, k = _dg_peak(H, S, ups)
         # the real lower bound also where the D-G bound peaks: a loop that uses the
         # parameters' realness has its complex peaks elsewhere
         wreal = np.union1d(wpk, final.omega[k:k + 1])

@@ -729,7 +729,7 @@ def identify(true, engineering, *, excitation: str, measurement: str, control_in
     True
     """
     t0 = time.perf_counter()
-    _check_search_arguments(max_tries, time_limit, tol)
+    _check_search_arguments(max_tries, time_limit, tol, real)
     say = _logger(out)
     measured, measured_fit = None, None
     if isinstance(true, FRF):
@@ -778,7 +778,7 @@ def _logger(out):
     return say
 
 
-def _check_search_arguments(max_tries, time_limit, tol) -> None:
+def _check_search_arguments(max_tries, time_limit, tol, real) -> None:
     if isinstance(max_tries, (bool, np.bool_)) or not isinstance(max_tries, (int, np.integer)) or max_tries < 1:
         raise ModelError(f"identify: max_tries must be a positive integer (the number of D-K runs allowed), "
                          f"got {max_tries!r}")
@@ -788,6 +788,8 @@ def _check_search_arguments(max_tries, time_limit, tol) -> None:
         raise ModelError(f"identify: time_limit must be a positive number of seconds or None, got {time_limit!r}")
     if not (isinstance(tol, (int, float, np.integer, np.floating)) and 0 < tol < 1):
         raise ModelError(f"identify: tol must lie in (0, 1), got {tol!r}")
+    if not isinstance(real, (bool, np.bool_)):
+        raise ModelError(f"identify: real must be True or False, got {real!r}")
 
 
 def _true_from_measured(measured, engineering, omega, excitation, measurement, max_fit_residual, say):

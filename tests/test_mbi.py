@@ -110,6 +110,8 @@ def test_bad_inputs_get_clear_errors():
         identify(T, E, **ports, omega=[0.0, 1.0, 2.0], out=None)
     with pytest.raises(IllPosedError, match="nothing to identify"):
         identify(E, E, **ports, out=None)
+    with pytest.raises(ModelError, match="real must be True or False, got 'no'"):
+        identify(T, E, **ports, real="no", out=None)
 
 
 def _check_trial(name, res, rtol):
