@@ -64,7 +64,11 @@ and not unique away from the peak.  Prototypes of that kind on the two-mass
 problem (fitted centre filters; the pointwise "mu-K" shrinkage of the real
 channels; Young's affine form with para-skew G filters made causal by an
 all-pass, exact on the axis) gave D-G bounds of 1.02-1.49 (the book's mu
-chapter has the details).
+chapter has the details).  :func:`refine_controller` avoids the filters: it
+keeps the optimal D-G scalings of every frequency and moves the controller's
+parameters instead (trust-region steps on the peak of the scaled bound, each
+checked on the recomputed D-G bound); 80 steps take the D-G-K controller
+above from 1.0131 to 1.0082 with the same 20 states.
 
 After the iteration the best closed loop is analysed
 with the optimal, unfitted scalings on a fine grid whose peaks are refined
@@ -114,6 +118,7 @@ References
 from __future__ import annotations
 
 import time
+import warnings
 from dataclasses import dataclass, field
 
 import control as ct
@@ -126,7 +131,7 @@ from .lti import as_ss, blas_single_thread, freqresp, lft_lower, ss
 from .mu import BlockStructure, MuSweep, default_grid, mu_sweep, mu_upper
 
 __all__ = ["DScaleFit", "fit_dscale", "fit_dscale_auto", "scaled_plant", "DKResult", "dk_iteration",
-           "dgk_iteration", "real_scaled_plant", "near_axis_poles"]
+           "dgk_iteration", "real_scaled_plant", "refine_controller", "near_axis_poles"]
 
 
 
@@ -1117,6 +1122,8 @@ def dgk_iteration(P, structure: BlockStructure, nmeas: int, ncon: int, *, step: 
     (Young's affine form) or the disc transform (:func:`mutext.mu.dg_disc`)
     would let each frequency use its own disc; the fits of their para-skew
     filters were the obstacle (see the mu chapter of the book).
+    :func:`refine_controller` uses the scalings of every frequency without
+    fits, by moving the controller this search returns.
 
     Parameters
     ----------
@@ -1254,3 +1261,445 @@ def dgk_iteration(P, structure: BlockStructure, nmeas: int, ncon: int, *, step: 
                    f"the plant as given mu <= {r.mu_upper_dg:.5f} with D-G scalings (plain D-K: {v1:.5f})")
     _print(out, f"D-G-K best: c = {best:.4f}, mu <= {r.mu_upper_dg:.5f} (D-G), plain D-K {v1:.5f}")
     return r
+
+
+# ----------------------------------------------------------------------------
+# the controller refined with the D-G scalings of every frequency (no fits)
+# ----------------------------------------------------------------------------
+
+class _Modal:
+    r"""A controller in real modal form, each mode's input and output balanced.
+
+    Parameters ``theta``: the real parts and imaginary parts of the modes (one
+    per real mode, two per complex pair: the block
+    :math:`\begin{bmatrix}\sigma & \omega\\ -\omega & \sigma\end{bmatrix}`),
+    then ``B`` (row-major), ``C`` (row-major) and ``D``; ``scale`` the size of
+    each, which sets the trust region.
+    """
+
+    def __init__(self, K):
+        A, B, C, D = (np.asarray(X, float) for X in (K.A, K.B, K.C, K.D))
+        n = A.shape[0]
+        self.n, self.ny, self.nu = n, B.shape[1], C.shape[0]
+        cols, size = [], []
+        if n:
+            lam, V = np.linalg.eig(A)
+            order = np.lexsort((-lam.imag, np.round(lam.real, 10)))
+            lam, V = lam[order], V[:, order]
+            from scipy.linalg import cdf2rdf
+            _, T = cdf2rdf(lam, V)
+            self.cond = float(np.linalg.cond(T))
+            if not np.isfinite(self.cond) or self.cond > 1e10:
+                raise ModelError(f"the controller has no usable modal form (eigenvector condition number "
+                                 f"{self.cond:.3g}: repeated or defective poles)")
+            Ti = np.linalg.inv(T)
+            A, B, C = Ti @ A @ T, Ti @ B, C @ T
+            i = 0
+            g = np.ones(n)
+            while i < n:
+                m = 2 if (i + 1 < n and abs(A[i, i + 1]) > 1e-12 * (1.0 + abs(A[i, i]))) else 1
+                e = np.zeros((n, n))
+                e[i:i + m, i:i + m] = np.eye(m)
+                cols.append(e.ravel())
+                if m == 2:
+                    e = np.zeros((n, n))
+                    e[i, i + 1], e[i + 1, i] = 1.0, -1.0
+                    cols.append(e.ravel())
+                    size += [np.hypot(A[i, i], A[i, i + 1])] * 2
+                else:
+                    size.append(abs(A[i, i]))
+                gb = np.linalg.norm(B[i:i + m]) + 1e-300
+                gc = np.linalg.norm(C[:, i:i + m]) + 1e-300
+                g[i:i + m] = np.sqrt(gc / gb)
+                i += m
+            B, C = B * g[:, None], C / g[None, :]
+        else:
+            self.cond = 1.0
+        self.E = np.array(cols).T if cols else np.zeros((0, 0))
+        thA = np.linalg.lstsq(self.E, A.ravel(), rcond=None)[0] if n else np.zeros(0)
+        self.na = thA.size
+        self.theta = np.concatenate([thA, B.ravel(), C.ravel(), D.ravel()])
+        ref = max(np.abs(self.theta).max(), 1e-12)
+        self.scale = np.concatenate([np.maximum(size, 1e-9 * ref), np.abs(B.ravel()), np.abs(C.ravel()),
+                                     np.abs(D.ravel())])
+        self.scale = np.maximum(self.scale, 1e-6 * ref)
+
+    def matrices(self, theta):
+        n, ny, nu, na = self.n, self.ny, self.nu, self.na
+        A = (self.E @ theta[:na]).reshape(n, n) if n else np.zeros((0, 0))
+        B = theta[na:na + n * ny].reshape(n, ny)
+        C = theta[na + n * ny:na + n * ny + nu * n].reshape(nu, n)
+        D = theta[na + n * ny + nu * n:].reshape(nu, ny)
+        return A, B, C, D
+
+    def ss(self, theta):
+        return ss(*self.matrices(theta))
+
+    def response(self, theta, s):
+        """K(s) (nw, nu, ny) and the resolvent factors C(sI-A)^-1 (nw, nu, n), (sI-A)^-1 B (nw, n, ny)."""
+        A, B, C, D = self.matrices(theta)
+        n = self.n
+        Z = s[:, None, None] * np.eye(n) - A
+        Br = np.linalg.solve(Z, np.broadcast_to(B, (s.size, n, self.ny)))
+        Cr = np.swapaxes(np.linalg.solve(np.swapaxes(Z, 1, 2), np.broadcast_to(C.T, (s.size, n, self.nu))), 1, 2)
+        return Cr @ B + D, Cr, Br
+
+    def d_response(self, Cr, Br):
+        """dK/dtheta: (nw, nu*ny, ntheta), K flattened row-major."""
+        nw, n, ny, nu = Cr.shape[0], self.n, self.ny, self.nu
+        dA = np.einsum("wla,wbk->wlkab", Cr, Br).reshape(nw, nu * ny, n * n) @ self.E
+        eye_y, eye_u = np.eye(ny), np.eye(nu)
+        dB = np.einsum("wla,kc->wlkac", Cr, eye_y).reshape(nw, nu * ny, n * ny)
+        dC = np.einsum("lm,wak->wlkma", eye_u, Br).reshape(nw, nu * ny, nu * n)
+        dD = np.broadcast_to(np.eye(nu * ny), (nw, nu * ny, nu * ny))
+        return np.concatenate([dA, dB, dC, dD], axis=2)
+
+    def sensitivity_factors(self, Lft, Rgt, Cr, Br):
+        r"""For the linear functional :math:`dK \mapsto L\,dK\,R` (``Lft`` (m, nu), ``Rgt`` (ny, m)):
+        its value for each parameter, (ntheta, m, m)."""
+        n = self.n
+        X = Lft @ Cr                    # (m, n)
+        Zr = Br @ Rgt                   # (n, m)
+        FA = np.einsum("ia,bj->abij", X, Zr).reshape(n * n, X.shape[0], -1)
+        FA = np.einsum("pij,pq->qij", FA, self.E) if n else FA[:0]
+        FB = np.einsum("ia,kj->akij", X, Rgt).reshape(n * self.ny, X.shape[0], -1)
+        FC = np.einsum("il,aj->laij", Lft, Zr).reshape(self.nu * n, X.shape[0], -1)
+        FD = np.einsum("il,kj->lkij", Lft, Rgt).reshape(self.nu * self.ny, X.shape[0], -1)
+        return np.concatenate([FA, FB, FC, FD], axis=0)
+
+
+def _augmented_loop(P, K, nc, nr, nmeas, ncon):
+    """The loop of ``P`` and ``K`` with an extra input ``v`` added to ``u`` and ``y`` as an extra
+    output: inputs ``[w, v]``, outputs ``[z, y]``; its blocks are M, U (z from v), V (y from w)."""
+    A, B, C, D = (np.asarray(X, float) for X in (P.A, P.B, P.C, P.D))
+    Bw, Bu = B[:, :nr], B[:, nr:]
+    Cz, Cy = C[:nc], C[nc:]
+    Dz, Dy = D[:nc], D[nc:]
+    Pa = ss(A, np.hstack([Bw, Bu, Bu]), np.vstack([Cz, Cy, Cy]),
+            np.block([[Dz[:, :nr], Dz[:, nr:], Dz[:, nr:]], [Dy[:, :nr], Dy[:, nr:], Dy[:, nr:]],
+                      [Dy[:, :nr], Dy[:, nr:], Dy[:, nr:]]]))
+    return lft_lower(Pa, K, nmeas, ncon)
+
+
+class _DGPoint:
+    """Scalings of one frequency in the form lambda_max(Q) = bound^2,
+    Q = R (M^H Dl M + j(GM - M^H G)) R, R = Dr^(-1/2)."""
+    __slots__ = ("value", "Dl", "R", "G")
+
+    def __init__(self, value, Dl, R, G):
+        self.value, self.Dl, self.R, self.G = value, Dl, R, G
+
+    def q(self, M):
+        return self.R @ (M.conj().T @ self.Dl @ M + 1j * (self.G @ M - M.conj().T @ self.G.conj().T)) @ self.R
+
+
+def _dg_point(M, S: BlockStructure) -> _DGPoint:
+    """D-G scalings of one frequency: the fast descent's, or the LMI's where those do not
+    reproduce the fast value to 1e-3.  The value is sqrt(lambda_max(Q)) for the scalings
+    kept, so certified by them."""
+    for method in ("fast", "lmi"):
+        u = mu_upper(M, S, method=method)
+        if u.Dl is None:          # one full block: sigma_max is mu
+            nr, nc = M.shape[1], M.shape[0]
+            pt = _DGPoint(u.value, np.eye(nc), np.eye(nr), np.zeros((nr, nc)))
+        else:
+            ev, V = np.linalg.eigh(u.Dr)
+            R = (V * ev ** -0.5) @ V.conj().T
+            pt = _DGPoint(u.value, u.Dl, R, np.zeros_like(u.Dl) if u.G is None else u.G)
+        lam = np.linalg.eigvalsh(pt.q(M))[-1]
+        if lam <= u.value ** 2 * (1.0 + 1e-3):
+            pt.value = float(np.sqrt(max(lam, 0.0)))
+            return pt
+    raise SolverError(f"no consistent D-G scalings for a {M.shape[0]}x{M.shape[1]} loop matrix")
+
+
+def _dg_points(Ms, S, old=None, reject_at=np.inf):
+    """Scalings of every frequency.  With ``old`` (the scalings of the previous controller):
+    the old scalings' values are upper bounds; new scalings are computed from the largest of
+    them down until the next cannot raise the peak (the same rule as :func:`_dg_peak`).
+    Returns None as soon as one frequency's bound reaches ``reject_at``."""
+    if old is None:
+        return [_dg_point(M, S) for M in Ms]
+    pts = []
+    for M, o in zip(Ms, old):
+        lam = np.linalg.eigvalsh(o.q(M))[-1]
+        pts.append(_DGPoint(float(np.sqrt(max(lam, 0.0))), o.Dl, o.R, o.G))
+    best = 0.0
+    for k in np.argsort([-p.value for p in pts]):
+        if pts[k].value <= best:
+            break
+        pts[k] = _dg_point(Ms[k], S)
+        best = max(best, pts[k].value)
+        if best >= reject_at:
+            return None
+    return pts
+
+
+def _refine_step(modal, theta, pts, M, U, V, Kw, Cr, Br, rho, band=0.01, gap=0.02):
+    """Trust-region model step: minimise max over the active frequencies of the linearised
+    lambda_max of Q (on its top eigenspace), with every parameter moving at most ``rho`` of
+    its size and K(jw) at most ``rho`` of its norm at every frequency.  Returns the step
+    (in units of ``modal.scale``) and the predicted peak of lambda_max, or None."""
+    import cvxpy as cp
+    Q = np.array([p.q(m) for p, m in zip(pts, M)])
+    lam, Y = np.linalg.eigh(Q)
+    top = lam[:, -1]
+    peak = top.max()
+    act = np.flatnonzero(top > peak * (1.0 - 2.0 * band))
+    nt = theta.size
+    d = cp.Variable(nt)
+    tau = cp.Variable()
+    lin_rows, lin_rhs, lmis = [], [], []
+    for k in act:
+        sel = lam[k] > lam[k, -1] * (1.0 - gap)
+        Yk = Y[k][:, sel]
+        p = pts[k]
+        Lft = Yk.conj().T @ p.R @ (M[k].conj().T @ p.Dl + 1j * p.G) @ U[k]
+        Rgt = V[k] @ p.R @ Yk
+        F = modal.sensitivity_factors(Lft, Rgt, Cr[k], Br[k]) * modal.scale[:, None, None]
+        H = F + np.conj(np.swapaxes(F, 1, 2))
+        m = Yk.shape[1]
+        if m == 1:
+            lin_rows.append(np.real(H[:, 0, 0]))
+            lin_rhs.append(lam[k][sel][0])
+        else:
+            Hr = np.real(H).reshape(nt, m * m).T
+            Hi = np.imag(H).reshape(nt, m * m).T
+            Xr = cp.reshape(Hr @ d, (m, m), order="C") + np.diag(lam[k][sel])
+            Xi = cp.reshape(Hi @ d, (m, m), order="C")
+            big = cp.bmat([[Xr, -Xi], [Xi, Xr]])
+            lmis.append(tau * np.eye(2 * m) - 0.5 * (big + big.T) >> 0)
+    cons = list(lmis)
+    if lin_rows:
+        cons.append(np.array(lin_rhs) + np.array(lin_rows) @ d <= tau)
+    J = modal.d_response(Cr, Br) * modal.scale[None, None, :]
+    Kn = np.linalg.norm(Kw.reshape(Kw.shape[0], -1), axis=1)
+    J = J / np.maximum(Kn, 1e-300)[:, None, None]
+    nk = J.shape[1]
+    Jr = np.real(J).reshape(-1, nt)
+    Ji = np.imag(J).reshape(-1, nt)
+    stacked = cp.reshape(cp.hstack([Jr @ d, Ji @ d]), (2 * nk, J.shape[0]), order="F")
+    cons += [cp.abs(d) <= rho, cp.norm(stacked, 2, axis=0) <= rho]
+    prob = cp.Problem(cp.Minimize(tau), cons)
+    # a model step needs no more than a few digits (every step is checked on the true bound)
+    for solver, opts in ((cp.CLARABEL, {"tol_feas": 1e-6, "tol_gap_abs": 1e-6, "tol_gap_rel": 1e-6,
+                                        "reduced_tol_feas": 1e-3, "reduced_tol_gap_abs": 1e-3,
+                                        "reduced_tol_gap_rel": 1e-3}),
+                         (cp.SCS, {})):
+        try:
+            with warnings.catch_warnings():
+                warnings.simplefilter("ignore")      # "solution may be inaccurate": the step is checked anyway
+                prob.solve(solver=solver, **opts)
+        except (cp.error.SolverError, ValueError, ArithmeticError):
+            continue
+        if d.value is not None and tau.value is not None:
+            return np.asarray(d.value, float), float(tau.value), float(peak)
+    return None
+
+
+def refine_controller(P, structure: BlockStructure, K, nmeas: int, ncon: int, *, omega=None,
+                      max_steps: int = 60, time_limit: float | None = None, regrid_every: int = 15,
+                      out=None, progress=None) -> DKResult:
+    r"""Lower the D-G bound of a loop by moving its controller, with the scalings of every frequency.
+
+    The K step of D-K iteration needs rational scalings, and with real
+    parameters their G scalings are the obstacle (see :func:`dgk_iteration`).
+    Here the controller itself is the unknown and the scalings are never
+    fitted: at each frequency of a grid, the D-G upper bound of the loop
+    :math:`M = \mathcal F_\ell(P, K)` is :math:`\beta^2 = \lambda_{\max}(Q)`,
+
+    .. math::
+
+        Q = D_r^{-1/2}\big(M^H D_\ell M + j(GM - M^HG^H)\big)D_r^{-1/2},
+
+    with the scalings :math:`D_\ell, D_r, G` optimal for the current
+    controller (``mutext.mu.mu_upper(method="fast")``, the LMI where the fast
+    scalings do not reproduce their value).  With the scalings held, the peak
+    of :math:`\lambda_{\max}(Q)` over the grid is a function of the
+    controller's parameters (its real modal form: the modes, ``B``, ``C``,
+    ``D``; the order stays).  Its linearisation on the top eigenspace of each
+    frequency near the peak, :math:`dM = U\,dK\,V` with :math:`U, V` the
+    closed-loop maps from the control input to ``z`` and from ``w`` to the
+    measurement, gives a small semidefinite program for the step, inside a
+    trust region (each parameter and :math:`K(j\omega)` at every frequency
+    move at most a fraction :math:`\rho` of their size).  A step counts only
+    if the loop stays stable and the D-G bound recomputed for the new
+    controller (new scalings where the old ones could decide the peak) falls:
+    the result is never worse than the controller given.  Every
+    ``regrid_every`` accepted steps the grid is refined around the largest
+    local maxima, where a step may have raised a peak between grid points.
+
+    This is a local descent on a non-smooth function (the peak over
+    frequencies and over eigenvalues), in the spirit of the non-smooth
+    mu-synthesis of Apkarian and Noll [AN]_: progress is steady but slow (on
+    the two-mass problem at 0.041 m, a D-K controller's 1.0160 falls to
+    about 1.010 in 100 steps), and it stops at a local minimum.
+
+    Parameters
+    ----------
+    P, structure, nmeas, ncon
+        As for :func:`dk_iteration`.
+    K : control.StateSpace
+        A stabilising controller, e.g. ``dgk_iteration(...).K``; its poles must be
+        simple enough for a real modal form (eigenvector condition number up to 1e10).
+    omega : array_like, optional
+        Starting grid (default: the grid of the final analysis of
+        :func:`dk_iteration`, 200 points 1.5 decades beyond the loop's poles,
+        plus the D-step grid).  Frequencies within 0.1 % of a lightly damped
+        pole of ``P`` are left out (the loop is computed from its own
+        realisation, so this only avoids ill-conditioned points).
+    max_steps : int
+        Largest number of model steps (accepted or not).
+    time_limit : float, optional
+        Seconds after which no new step is started.
+    regrid_every : int
+        Accepted steps between grid refinements.
+    out : file or None
+        Where to print one line per step.
+    progress : callable, optional
+        ``progress(stage, fraction)`` once per step.
+
+    Returns
+    -------
+    DKResult
+        ``K`` the refined controller (same order), ``CL``, ``mu_upper_dg``,
+        ``mu_lower`` and the other bounds from the same final analysis as
+        :func:`dk_iteration` (a fine grid independent of the refinement grid),
+        ``history`` one row per step (``step``, ``mu_dg`` on the refinement
+        grid, ``rho``, ``accepted``, ``grid_points``, ``seconds``).
+
+    Raises
+    ------
+    ModelError
+        Sizes that do not match, a controller that does not stabilise ``P``,
+        a controller without a usable modal form, bad options.
+
+    References
+    ----------
+    .. [AN] P. Apkarian and D. Noll, "Nonsmooth H-infinity synthesis", *IEEE
+       Trans. Automatic Control* 51 (2006) 71-86.
+
+    Examples
+    --------
+    Two steps on the first D-K controller (the H-infinity one) of the two-mass problem at
+    0.043 m (about 10 s):
+
+    >>> from mutext.examples import two_mass_uncertain as tmu
+    >>> P = tmu.plant(0.043)
+    >>> dkr = dk_iteration(P, tmu.structure(), 1, 1, max_iter=1)
+    >>> ref = refine_controller(P, tmu.structure(), dkr.K, 1, 1, max_steps=2)
+    >>> bool(ref.mu_upper_dg <= dkr.mu_upper_dg + 1e-9), ref.K.nstates == dkr.K.nstates
+    (True, True)
+    """
+    t0 = time.perf_counter()
+    P = as_ss(P, "P")
+    if not isinstance(structure, BlockStructure):
+        raise ModelError(f"structure must be a BlockStructure, got {type(structure).__name__}")
+    S = structure
+    _check_sizes(P, S, nmeas, ncon)
+    K = as_ss(K, "K")
+    if K.ninputs != nmeas or K.noutputs != ncon:
+        raise ModelError(f"K has {K.ninputs} inputs and {K.noutputs} outputs, but nmeas={nmeas}, ncon={ncon}")
+    for name, v, least in (("max_steps", max_steps, 1), ("regrid_every", regrid_every, 1)):
+        if isinstance(v, (bool, np.bool_)) or not (isinstance(v, (int, np.integer)) and v >= least):
+            raise ModelError(f"{name} must be an integer >= {least}, got {v!r}")
+    if time_limit is not None and not (isinstance(time_limit, (int, float, np.integer, np.floating))
+                                       and not isinstance(time_limit, bool) and time_limit > 0):
+        raise ModelError(f"time_limit must be a positive number of seconds or None, got {time_limit!r}")
+    nc, nr = S.ncols, S.nrows
+    CL0 = lft_lower(P, K, nmeas, ncon)
+    cl_poles = np.linalg.eigvals(np.asarray(CL0.A, float)) if CL0.nstates else np.zeros(0)
+    if cl_poles.size and cl_poles.real.max() >= 0:
+        raise ModelError(f"K does not stabilise P (closed-loop pole with real part {cl_poles.real.max():.3g})")
+    modal = _Modal(K)
+    theta = modal.theta.copy()
+    if omega is None:
+        w = np.unique(np.concatenate([default_grid(CL0, n=200, decades=1.5), _default_dk_grid(P, 80)]))
+    else:
+        w = np.unique(np.asarray(omega, float).ravel())
+        if w.size == 0 or not (np.all(np.isfinite(w)) and np.all(w > 0)):
+            raise ModelError("the frequency grid omega must hold positive, finite frequencies (rad/s)")
+    ppoles = np.linalg.eigvals(np.asarray(P.A, float)) if P.nstates else np.zeros(0)
+    light = np.abs(ppoles[np.abs(ppoles.real) < 1e-3 * np.abs(ppoles)].imag)
+
+    def usable(w):
+        return w[np.min(np.abs(w[:, None] - light[None, :]), axis=1) > 1e-3 * w] if light.size else w
+
+    def evaluate(theta, w):
+        Kt = modal.ss(theta)
+        CLa = _augmented_loop(P, Kt, nc, nr, nmeas, ncon)
+        poles = np.linalg.eigvals(np.asarray(CLa.A, float)) if CLa.nstates else np.zeros(0)
+        stable = not poles.size or poles.real.max() < 0
+        F = np.moveaxis(freqresp(CLa, w), -1, 0)
+        return stable, F[:, :nc, :nr], F[:, :nc, nr:], F[:, nc:, :nr]
+
+    w = usable(w)
+    stable, M, U, V = evaluate(theta, w)
+    pts = _dg_points(M, S)
+    start = max(p.value for p in pts)
+    history, notes = [], []
+    rho, accepted = 1e-3, 0
+    _print(out, f"{'step':>4} {'mu D-G (grid)':>14} {'model':>9} {'rho':>9} {'':>8} {'grid':>5} {'seconds':>8}")
+    with blas_single_thread():
+        for step in range(1, max_steps + 1):
+            if time_limit is not None and time.perf_counter() - t0 > time_limit:
+                notes.append(f"refine: time limit of {time_limit:g} s reached after {step - 1} steps")
+                break
+            if progress is not None:
+                progress(f"refine step {step}/{max_steps}: mu D-G {max(p.value for p in pts):.5f}, "
+                         f"{w.size} frequencies", (step - 1) / max_steps)
+            ti = time.perf_counter()
+            peak = max(p.value for p in pts)
+            Kw, Cr, Br = modal.response(theta, 1j * w)
+            res = _refine_step(modal, theta, pts, M, U, V, Kw, Cr, Br, rho)
+            ok = False
+            model = float("nan")
+            if res is not None:
+                dstep, tau, lam_peak = res
+                model = float(np.sqrt(max(tau, 0.0)))
+                pred = lam_peak - tau
+                if pred > 1e-12 * lam_peak:
+                    cand = theta + modal.scale * dstep
+                    st, Mn, Un, Vn = evaluate(cand, w)
+                    if st:
+                        new = _dg_points(Mn, S, pts, reject_at=peak * (1.0 - 1e-9))
+                        vn = np.inf if new is None else max(p.value for p in new)
+                        if vn < peak * (1.0 - 1e-9):
+                            ok = True
+                            ratio = (peak ** 2 - vn ** 2) / pred
+                            theta, M, U, V, pts = cand, Mn, Un, Vn, new
+                            rho = min(2.0 * rho, 0.2) if ratio > 0.5 else (rho / 2.0 if ratio < 0.1 else rho)
+            if not ok:
+                rho /= 4.0
+            else:
+                accepted += 1
+            mu_now = max(p.value for p in pts)
+            history.append({"step": step, "mu_dg": mu_now, "model": model, "rho": rho, "accepted": ok,
+                            "grid_points": int(w.size), "seconds": time.perf_counter() - ti})
+            _print(out, f"{step:>4} {mu_now:>14.6f} {model:>9.5f} {rho:>9.2e} {'accepted' if ok else 'rejected':>8} "
+                        f"{w.size:>5} {time.perf_counter() - ti:>8.2f}")
+            if ok and accepted % regrid_every == 0:
+                vals = np.array([p.value for p in pts])
+                extra = [np.logspace(np.log10(w[max(i - 1, 0)]), np.log10(w[min(i + 1, w.size - 1)]), 8)[1:-1]
+                         for i in _local_maxima(vals, 10)]
+                w = usable(np.unique(np.concatenate([w] + extra)))
+                stable, M, U, V = evaluate(theta, w)
+                pts = _dg_points(M, S)
+            if rho < 1e-7:
+                notes.append(f"refine: stopped at step {step}, no model step lowers the bound (trust region {rho:.1e})")
+                break
+    Kr = modal.ss(theta)
+    CL = lft_lower(P, Kr, nmeas, ncon)
+    cl_poles = np.linalg.eigvals(np.asarray(CL.A, float)) if CL.nstates else np.zeros(0)
+    max_re = float(cl_poles.real.max()) if cl_poles.size else float("-inf")
+    final, low, low_c, mu_dg = _final_analysis(CL, S, _default_dk_grid(P, 80), 200, True,
+                                               report=None if progress is None else
+                                               (lambda stage, f: progress(stage, 0.95 + 0.05 * f)))
+    notes.append(f"refine: {accepted} of {len(history)} steps accepted; D-G bound on the refinement grid "
+                 f"{start:.5f} -> {max(p.value for p in pts):.5f}, on the final grid {mu_dg:.5f}")
+    _print(out, f"refined: fine grid: {low:.4f} <= mu <= {mu_dg:.4f} (D-G), {final.peak_upper:.4f} complex; "
+                f"controller order {Kr.nstates}; {time.perf_counter() - t0:.1f} s")
+    return DKResult(K=Kr, CL=CL, mu_upper=float(final.peak_upper), mu_upper_dg=mu_dg, mu_lower=low,
+                    mu_lower_complex=low_c, peak_frequency=float(final.peak_frequency), history=history,
+                    sweep=final, fits=[], seconds=time.perf_counter() - t0, best_iteration=0, notes=notes,
+                    near_axis_poles=near_axis_poles(P), max_pole_real=max_re)

@@ -280,6 +280,24 @@ def test_two_mass_mu_real_parameters(capsys):
 def test_two_mass_mu_bad_xmax(capsys):
     assert cli.main(["demo", "two-mass-mu", "--xmax", "-1"]) == 1
     assert "--xmax" in capsys.readouterr().err
+    assert cli.main(["demo", "two-mass-mu", "--refine", "-1"]) == 1
+    assert "--refine must be a number of steps >= 0, got -1" in capsys.readouterr().err
+
+
+@pytest.mark.slow
+def test_two_mass_mu_refined(capsys):
+    """``--refine``: the design's controller moved by a few steps on the D-G bound; the bound
+    never rises, the iterations reported are the design's, the corners (rebuilt from M and K)
+    stay stable."""
+    assert cli.main(["demo", "two-mass-mu", "--xmax", "0.041", "--max-iter", "2", "--refine", "3",
+                     "--json"]) == 0
+    captured = capsys.readouterr()
+    out = json.loads(captured.out)
+    assert len(out["iterations"]) == 2 and len(out["refine_steps"]) == 3
+    assert out["mu_upper_dg"] <= out["refined_from"] * (1 + 1e-9)
+    assert out["mu_lower"] <= out["mu_upper_dg"] * (1 + 1e-9)
+    assert out["nominal_stable"] and out["corners_stable"]
+    assert "mu D-G (grid)" in captured.err and any(n.startswith("refine: ") for n in out["notes"])
 
 
 @pytest.mark.slow

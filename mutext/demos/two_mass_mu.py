@@ -17,7 +17,7 @@ import time
 
 import numpy as np
 
-from ..dk import dgk_iteration, dk_iteration
+from ..dk import dgk_iteration, dk_iteration, refine_controller
 from ..examples import two_mass_uncertain as tmu
 from ..lti import hinf_norm, lft_lower
 
@@ -30,6 +30,10 @@ def add_arguments(p):
     p.add_argument("--real", action="store_true",
                    help="keep the parameters real in the design (D-G-K: up to six D-K runs with the "
                         "parameters' ranges scaled in the K steps, judged by the D-G bound; under a minute)")
+    p.add_argument("--refine", type=int, default=0, metavar="STEPS",
+                   help="then refine the controller by this many steps on the D-G bound with the "
+                        "scalings of every frequency (mutext.dk.refine_controller; 80 steps take about "
+                        "two minutes and lower mu by about 0.5 %%)")
 
 
 def check_controller(K, x_max: float, rel: float = 0.02) -> dict:
@@ -63,9 +67,11 @@ def check_controller(K, x_max: float, rel: float = 0.02) -> dict:
     }
 
 
-def solve(x_max: float = 0.035, max_iter: int = 6, out=sys.stderr, progress=None, real: bool = False) -> dict:
-    """Run the D-K iteration (``real``: :func:`mutext.dk.dgk_iteration`) and the checks;
-    everything the demo and the tests report.
+def solve(x_max: float = 0.035, max_iter: int = 6, out=sys.stderr, progress=None, real: bool = False,
+          refine: int = 0) -> dict:
+    """Run the D-K iteration (``real``: :func:`mutext.dk.dgk_iteration`), ``refine`` steps of
+    :func:`mutext.dk.refine_controller` if asked, and the checks; everything the demo and the
+    tests report.
 
     ``progress(stage, fraction)`` is passed to the iteration."""
     t0 = time.perf_counter()
@@ -75,6 +81,12 @@ def solve(x_max: float = 0.035, max_iter: int = 6, out=sys.stderr, progress=None
     synth = dgk_iteration if real else dk_iteration
     res = synth(P, tmu.structure(), 1, 1, max_iter=max_iter, max_states=P.nstates + 16, out=out,
                 progress=progress)
+    design, refined_from, steps = res, None, []
+    if refine:
+        # the controller and its bounds become the refined ones; the iterations stay the design's
+        refined_from = res.mu_upper_dg
+        res = refine_controller(P, tmu.structure(), res.K, 1, 1, max_steps=refine, out=out, progress=progress)
+        steps = res.history
     t_dk = time.perf_counter() - t0
     check = check_controller(res.K, x_max)
     poles = np.linalg.eigvals(np.asarray(res.K.A, float)) if res.K.nstates else np.zeros(0)
@@ -90,17 +102,19 @@ def solve(x_max: float = 0.035, max_iter: int = 6, out=sys.stderr, progress=None
         "mu_thesis": thesis,
         "iterations": [{"gamma": h["gamma"], "mu": h["mu"], "orders": h["orders"],
                         "controller_order": h["controller_order"], "seconds": h["seconds"]}
-                       for h in res.history],
-        "best_iteration": res.best_iteration,
-        "real_scale": res.real_scale,
-        "tries": list(res.tries),
+                       for h in design.history],
+        "best_iteration": design.best_iteration,
+        "real_scale": design.real_scale,
+        "refined_from": refined_from,
+        "refine_steps": [{"mu_dg": h["mu_dg"], "accepted": h["accepted"], "seconds": h["seconds"]} for h in steps],
+        "tries": list(design.tries),
         "controller_order": res.controller_order,
         "controller_unstable_poles": int(np.sum(poles.real > 0)),
         "thesis_controller_order": tmu.THESIS_ORDER,
         **check,
         "seconds_dk": t_dk,
         "seconds": time.perf_counter() - t0,
-        "notes": list(res.notes),
+        "notes": list(design.notes) + (list(res.notes) if refine else []),
     }
 
 
@@ -110,12 +124,16 @@ def run(args) -> int:
         raise ModelError(f"--xmax must be a positive length in m, got {args.xmax}")
     if args.max_iter < 1:
         raise ModelError(f"--max-iter must be at least 1, got {args.max_iter}")
+    if args.refine < 0:
+        raise ModelError(f"--refine must be a number of steps >= 0, got {args.refine}")
     how = ("D-G-K (parameters kept real)" if args.real else "D-K iteration")
+    if args.refine:
+        how += f", then {args.refine} refinement steps"
     print(f"two-mass mu-synthesis (thesis sec. 2.3.2): m1, m2, k1, k2 +/- 2 %, x1 < {args.xmax} m; "
           f"{how}:", file=sys.stderr, flush=True)
     from ..progress import ProgressLine
     prog = ProgressLine()
-    out = solve(args.xmax, args.max_iter, out=prog, progress=prog, real=args.real)
+    out = solve(args.xmax, args.max_iter, out=prog, progress=prog, real=args.real, refine=args.refine)
     if args.json:
         from ..jsonio import print_json
         print_json({k: v for k, v in out.items() if k != "result"})
@@ -129,6 +147,8 @@ def run(args) -> int:
     if out["tries"]:
         print("D-G-K tries (K steps with the ranges scaled by c; D-G bound of the loop as given): "
               + ", ".join(f"c = {t['scale']:.3f}: {t['mu_dg']:.4f}" for t in out["tries"]))
+    if out["refined_from"] is not None:
+        print(f"refined from (D-G bound of the design)      = {out['refined_from']:.4f}")
     if thesis is not None:
         print(f"thesis (MATLAB dksyn)                       = {thesis}")
     print(f"controller: {out['controller_order']} states, {out['controller_unstable_poles']} in the right "
