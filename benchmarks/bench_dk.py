@@ -9,7 +9,8 @@ patience=2``); ``mutext big`` (``n + 20``) and ``mutext patient``
 on request (``--tools``), as are ``mutext dgk`` and ``mutext dgk-demo``
 (:func:`mutext.dk.dgk_iteration`, real parameters kept real, with the
 options of ``default`` and ``demo``; its ``mu (own)`` is its D-G bound) and
-``mutext dgk-refine`` (``dgk-demo``'s controller then refined by 80 steps of
+``mutext dgk-refine`` (``dgk-demo``'s controller then refined by 80 steps,
+or ``--refine-steps``, of
 :func:`mutext.dk.refine_controller`, the D-G scalings of every frequency).  mutext's
 K step is its own (:func:`mutext.hinf.hinfsyn`); slycot only as a verified
 fallback.
@@ -65,8 +66,10 @@ dgk" "mutext dgk-demo"`` added (one run, 2 cores): D-G-K reached 1.0148 (16
 states, 35 s) and 1.0131 (20 states, 47 s) at 0.041 m, 1.1422 (16, 26 s) and
 1.1395 (20, 38 s) at 0.035 m, with complex bounds 0.4-0.8 % higher: those
 controllers use the parameters' realness.  Refining them (``mutext
-dgk-refine``, 80 steps) gave 1.0082 and 1.1332 with the same 20 states, in
-about 2 minutes more.
+dgk-refine``) gave, with the same 20 states, 0.9900 at 0.041 m (125 s in all)
+and 1.1381 at 0.035 m (81 s) with 80 steps, and 0.9895 (397 s) and 1.1211
+(513 s) with ``--refine-steps 300`` (dkpy fixed in the same run: 1.0142, 36
+states, 55 s, and its panic at 0.035 m).
 
 Usage::
 
@@ -112,6 +115,10 @@ def problem(name):
     raise SystemExit(f"unknown problem {name!r}")
 
 
+#: steps of refine_controller in ``mutext dgk-refine`` (``--refine-steps``)
+REFINE_STEPS = 80
+
+
 def run_mutext(name, config):
     from mutext.dk import dgk_iteration, dk_iteration
     P, ny, nu, S, _, _, omega = problem(name)
@@ -129,7 +136,7 @@ def run_mutext(name, config):
     if refine:
         from mutext.dk import refine_controller
         before = res.mu_upper_dg
-        ref = refine_controller(P, S, res.K, ny, nu, max_steps=80)
+        ref = refine_controller(P, S, res.K, ny, nu, max_steps=REFINE_STEPS)
         note = (f"c = {res.real_scale:.3f}, D-G {before:.5f}; refined: "
                 f"{sum(h['accepted'] for h in ref.history)}/{len(ref.history)} steps accepted")
         return ref.K, ref.mu_upper_dg, time.perf_counter() - t0, note
@@ -200,7 +207,10 @@ def main(argv=None) -> int:
     ap.add_argument("--timeout", type=float, default=600.0, help="seconds per synthesis (default 600)")
     ap.add_argument("--problems", nargs="+", default=["two-mass-0.035", "two-mass-0.041", "skogestad"])
     ap.add_argument("--tools", nargs="+", help="a subset of the tools (e.g. 'mutext demo' 'dkpy auto')")
+    ap.add_argument("--refine-steps", type=int, default=80, help="steps of 'mutext dgk-refine' (default 80)")
     args = ap.parse_args(argv)
+    global REFINE_STEPS
+    REFINE_STEPS = args.refine_steps
     from mutext.lti import ss
     try:
         import dkpy  # noqa: F401

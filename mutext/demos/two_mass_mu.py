@@ -32,8 +32,8 @@ def add_arguments(p):
                         "parameters' ranges scaled in the K steps, judged by the D-G bound; under a minute)")
     p.add_argument("--refine", type=int, default=0, metavar="STEPS",
                    help="then refine the controller by this many steps on the D-G bound with the "
-                        "scalings of every frequency (mutext.dk.refine_controller; 80 steps take about "
-                        "two minutes and lower mu by about 0.5 %%)")
+                        "scalings of every frequency (mutext.dk.refine_controller; about a second a step: "
+                        "with --real at 0.041 m, 300 steps reach mu = 0.9895)")
 
 
 def check_controller(K, x_max: float, rel: float = 0.02) -> dict:
