@@ -1560,7 +1560,8 @@ def refine_controller(P, structure: BlockStructure, K, nmeas: int, ncon: int, *,
     out : file or None
         Where to print one line per step.
     progress : callable, optional
-        ``progress(stage, fraction)`` once per step.
+        ``progress(stage, fraction)`` once per step (steps share 0-0.95 of the
+        bar, the final analysis the rest).
 
     Returns
     -------
@@ -1637,7 +1638,7 @@ def refine_controller(P, structure: BlockStructure, K, nmeas: int, ncon: int, *,
         return stable, F[:, :nc, :nr], F[:, :nc, nr:], F[:, nc:, :nr]
 
     w = usable(w)
-    stable, M, U, V = evaluate(theta, w)
+    _, M, U, V = evaluate(theta, w)
     pts = _dg_points(M, S)
     start = max(p.value for p in pts)
     history, notes = [], []
@@ -1650,7 +1651,7 @@ def refine_controller(P, structure: BlockStructure, K, nmeas: int, ncon: int, *,
                 break
             if progress is not None:
                 progress(f"refine step {step}/{max_steps}: mu D-G {max(p.value for p in pts):.5f}, "
-                         f"{w.size} frequencies", (step - 1) / max_steps)
+                         f"{w.size} frequencies", 0.95 * (step - 1) / max_steps)
             ti = time.perf_counter()
             peak = max(p.value for p in pts)
             Kw, Cr, Br = modal.response(theta, 1j * w)
@@ -1686,7 +1687,7 @@ def refine_controller(P, structure: BlockStructure, K, nmeas: int, ncon: int, *,
                 extra = [np.logspace(np.log10(w[max(i - 1, 0)]), np.log10(w[min(i + 1, w.size - 1)]), 8)[1:-1]
                          for i in _local_maxima(vals, 10)]
                 w = usable(np.unique(np.concatenate([w] + extra)))
-                stable, M, U, V = evaluate(theta, w)
+                _, M, U, V = evaluate(theta, w)
                 pts = _dg_points(M, S)
             if rho < 1e-7:
                 notes.append(f"refine: stopped at step {step}, no model step lowers the bound (trust region {rho:.1e})")
