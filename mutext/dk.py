@@ -123,6 +123,7 @@ from dataclasses import dataclass, field
 
 import control as ct
 import numpy as np
+from scipy.linalg import cdf2rdf
 
 from .errors import IllPosedError, InfeasibleError, ModelError, SolverError
 from .frfit import MagnitudeFit, _constant, fit_magnitude
@@ -658,6 +659,17 @@ def _local_maxima(values, count):
     return sorted(pk, key=lambda i: -v[i])[:count]
 
 
+def _around_peaks(w, values, npeaks: int, points: int) -> list:
+    """``points`` log-spaced frequencies strictly between the neighbours of each of the
+    ``npeaks`` largest local maxima of ``values`` on the grid ``w``."""
+    out = []
+    for i in _local_maxima(values, npeaks):
+        a, b = w[max(i - 1, 0)], w[min(i + 1, w.size - 1)]
+        if b > a:
+            out.append(np.logspace(np.log10(a), np.log10(b), points + 2)[1:-1])
+    return out
+
+
 def _fine_sweep(CL, S: BlockStructure, omega, npeaks: int = 4, rounds: int = 3, points: int = 16,
                 progress=None) -> tuple[MuSweep, np.ndarray]:
     """Diagonal-D upper bound on ``omega`` with its largest local maxima refined:
@@ -668,12 +680,7 @@ def _fine_sweep(CL, S: BlockStructure, omega, npeaks: int = 4, rounds: int = 3, 
     H = np.moveaxis(freqresp(CL, w), -1, 0)
     up, X = _sweep_upper(H, S, progress=progress)
     for _ in range(rounds):
-        new = []
-        for i in _local_maxima(up, npeaks):
-            a = w[max(i - 1, 0)]
-            b = w[min(i + 1, w.size - 1)]
-            if b > a:
-                new.append(np.logspace(np.log10(a), np.log10(b), points + 2)[1:-1])
+        new = _around_peaks(w, up, npeaks, points)
         if not new:
             break
         wn = np.setdiff1d(np.concatenate(new), w)
@@ -1286,7 +1293,6 @@ class _Modal:
             lam, V = np.linalg.eig(A)
             order = np.lexsort((-lam.imag, np.round(lam.real, 10)))
             lam, V = lam[order], V[:, order]
-            from scipy.linalg import cdf2rdf
             _, T = cdf2rdf(lam, V)
             self.cond = float(np.linalg.cond(T))
             if not np.isfinite(self.cond) or self.cond > 1e10:
@@ -1683,9 +1689,7 @@ def refine_controller(P, structure: BlockStructure, K, nmeas: int, ncon: int, *,
             _print(out, f"{step:>4} {mu_now:>14.6f} {model:>9.5f} {rho:>9.2e} {'accepted' if ok else 'rejected':>8} "
                         f"{w.size:>5} {time.perf_counter() - ti:>8.2f}")
             if ok and accepted % regrid_every == 0:
-                vals = np.array([p.value for p in pts])
-                extra = [np.logspace(np.log10(w[max(i - 1, 0)]), np.log10(w[min(i + 1, w.size - 1)]), 8)[1:-1]
-                         for i in _local_maxima(vals, 10)]
+                extra = _around_peaks(w, np.array([p.value for p in pts]), 10, 6)
                 w = usable(np.unique(np.concatenate([w] + extra)))
                 _, M, U, V = evaluate(theta, w)
                 pts = _dg_points(M, S)
