@@ -32,6 +32,7 @@ def refined():
         buf.getvalue(), calls
 
 
+@pytest.mark.slow
 def test_refined_loop_is_stable_and_lower_by_ab13md(refined):
     """Two-mass problem at 0.041 m: 25 steps lower the AB13MD bound of the D-K loop on the
     final grid (1.0186 to about 1.0165 when written), with a controller of the same order."""
@@ -47,6 +48,7 @@ def test_refined_loop_is_stable_and_lower_by_ab13md(refined):
     assert all(b <= a * (1 + 1e-12) for a, b in zip(mus, mus[1:]))
 
 
+@pytest.mark.slow
 def test_refined_bound_is_met_by_a_real_perturbation(refined):
     _, res, CL, _, _, _, _ = refined
     assert res.mu_upper_dg * (1 - 1e-4) <= res.mu_lower <= res.mu_upper_dg * (1 + 1e-9)
@@ -56,6 +58,7 @@ def test_refined_bound_is_met_by_a_real_perturbation(refined):
     assert np.linalg.svd(np.eye(6) - M @ Delta, compute_uv=False)[-1] < 1e-8
 
 
+@pytest.mark.slow
 def test_refine_reports_steps(refined):
     _, res, _, _, _, text, calls = refined
     assert "mu D-G (grid)" in text and "accepted" in text and "refined: fine grid" in text
