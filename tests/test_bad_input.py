@@ -1,4 +1,4 @@
-"""Regression tests for issue 16: bad, badly scaled or malformed inputs get a right
+"""Regression tests: bad, badly scaled or malformed inputs get a right
 result or a named mutext error (never a numpy/cvxpy/decoder traceback, never a
 silently wrong number)."""
 import numpy as np

@@ -1,4 +1,4 @@
-"""Property-based hostile inputs (issue 16): malformed and extreme FRF files, station
+"""Property-based hostile inputs: malformed and extreme FRF files, station
 tables, plants, block structures, frequency grids and weights for the public entry
 points.  Every call must end, within a time bound, in either a named mutext error
 or a result that passes its own verification; no other exception may escape.

@@ -360,7 +360,7 @@ def test_near_axis_poles_are_set_apart():
 
 
 def test_dk_on_a_weight_with_near_axis_poles():
-    """The K step no longer fails with dynamic scalings (issue 17); the verdict on the loop
+    """The K step no longer fails with dynamic scalings; the verdict on the loop
     is independent of mutext: python-control's lft, numpy eigenvalues, AB13MD on a grid
     that reaches below the weight's poles."""
     P = distillation_plant()

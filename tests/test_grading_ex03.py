@@ -200,7 +200,7 @@ def test_cli_list_shows_ex03(capsys):
 
 
 def test_nan_answers_are_named_not_a_crash(questions):
-    """Issue 21: NaN in (d) used to end in "could not be checked (ValueError: cannot convert float NaN ...)"."""
+    """NaN in (d) used to end in "could not be checked (ValueError: cannot convert float NaN ...)"."""
     nan = float("nan")
     score, fb = _check(questions, "d", lambda *a: [nan, nan, nan])
     assert score == 0
@@ -212,7 +212,7 @@ def test_nan_answers_are_named_not_a_crash(questions):
 
 
 def test_junk_values_get_no_factor_2_hint(questions):
-    """Issue 21: a placeholder 1 is not "a factor 2" (ratios 0.51-0.52 of the references)."""
+    """A placeholder 1 is not "a factor 2" (ratios 0.51-0.52 of the references)."""
     for qid in questions:
         kind = questions[qid].kind
         score, fb = _check(questions, qid, lambda *a: [1.0, 1.0, 1.0] if kind == "array" else 1.0)

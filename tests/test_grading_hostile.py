@@ -1,4 +1,4 @@
-"""The autograder against hostile submissions (issue 21).
+"""The autograder against hostile submissions.
 
 Every file in ``tests/grading_submissions/hostile/`` tries to score without
 solving the exercise, or to damage the grader: walking frames or the garbage

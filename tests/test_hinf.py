@@ -198,7 +198,7 @@ def test_near_axis_poles_are_named_when_synthesis_fails():
 
 
 def test_near_axis_closed_loop_norm_agrees_with_slycot():
-    """Issue 20: our norm said 1.14468 "at 0 rad/s", AB13DD 1.14070.  AB13DD was right:
+    """Our norm said 1.14468 "at 0 rad/s", AB13DD 1.14070.  AB13DD was right:
     the old freqresp (Hessenberg form after a balancing spanning 1e6) was 26 % off at DC.
     The reference here is independent of mutext: a dense complex solve of
     C (jwI - A)^-1 B + D on a grid, refined at the peak (it agrees with 50-digit mpmath

@@ -1,4 +1,4 @@
-"""Issue 20, deliverable 3: H-infinity controllers that achieve their level on badly scaled plants.
+"""H-infinity controllers that achieve their level on badly scaled plants.
 
 Everything is checked against references independent of mutext:
 
@@ -154,7 +154,7 @@ def _two_mass(which=None, value=None, c=1.0):
 
 @pytest.mark.parametrize("which", ["D12", "D21"])
 def test_nearly_singular_two_mass(which):
-    """D12 or D21 = 1e-5: the LMI controller sat at 30 % back-off (issue 20); the central
+    """D12 or D21 = 1e-5: the LMI controller sat at 30 % back-off; the central
     controller achieves the level at 1e-4.  slycot's gamma iteration answers here."""
     P = _two_mass(which, 1e-5)
     res = hinfsyn(P, 1, 1)

@@ -170,7 +170,7 @@ def test_balance_states_keeps_transfer_function():
     assert A.max() / A[A > 0].min() < np.abs(np.asarray(Gb.A)).max() / np.abs(np.asarray(Gb.A))[A > 0].min()
 
 
-# ------------------------------------------- stiff and badly scaled systems (issue 20)
+# ------------------------------------------- stiff and badly scaled systems
 
 def _direct(sys, omega):
     """Independent reference: C (jwI - A)^{-1} B + D by a dense complex solve per
@@ -241,7 +241,7 @@ def test_freqresp_matches_python_control_on_normal_systems():
         assert _relerr(freqresp(G, w), ref) < _solve_tol(G, w)
 
 
-# ------------------------------------------- imaginary-axis test (issue 20)
+# ------------------------------------------- imaginary-axis test
 
 def test_hinf_norm_slow_stable_pole_beside_fast_one_is_not_on_axis():
     # 1e-6/(s + 1e-6) + 1e8/(s + 1e8): peak 2 at DC; the old rule |Re p| <= 1e-12 max|p|
@@ -297,7 +297,7 @@ def test_hinf_norm_stiff_closed_loop_matches_mpmath_peak():
     assert nrm.value == pytest.approx(dc, rel=1e-6)
 
 
-# ------------------------------------------- stability test (issue 20)
+# ------------------------------------------- stability test
 
 def test_stability_integrator_hidden_in_stiff_system_is_not_called_stable():
     """An integrator and an undamped mode at 3 rad/s beside poles at -1e-6 and -1e8, hidden by a

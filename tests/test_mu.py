@@ -616,7 +616,7 @@ def test_fast_sweep_peak_against_ab13md():
 
 @pytest.mark.slow
 def test_fast_sweep_500_frequencies_against_ab13md():
-    # the problem of issue 17: 10 states, blocks r1 r1 C2x2 C1 C1, 500 frequencies
+    # the benchmark's sweep problem: 10 states, blocks r1 r1 C2x2 C1 C1, 500 frequencies
     rng = np.random.default_rng(0)
     S = BlockStructure([Block.real(), Block.real(), Block.full(2), Block.full(1), Block.full(1)])
     nb, it = np.array([1, 1, 2, 1, 1]), np.array([1, 1, 2, 2, 2])

@@ -1,4 +1,4 @@
-"""Hostile: walk the frames up to the audit hook, switch it off, import the solutions (issue 21)."""
+"""Hostile: walk the frames up to the audit hook, switch it off, import the solutions."""
 import sys
 _f = sys._getframe()
 while _f is not None and "guard" not in _f.f_locals:
