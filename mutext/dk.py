@@ -464,8 +464,11 @@ class DKResult:
         the final grid of the lower of the D-G bound
         (``mutext.mu.mu_upper(method="fast")``, computed from the largest
         complex values down until the next cannot raise the peak)
-        and the complex bound; equal to ``mu_upper`` without real blocks or
-        with ``dg=False``.
+        and the complex bound, with the local maxima of the D-G bound within
+        2 % of its peak refined in two rounds of 8 frequencies (a loop that
+        exploits the real parameters equalises the D-G bound, and its peak
+        can lie between the points refined for the complex bound); equal to
+        ``mu_upper`` without real blocks or with ``dg=False``.
     mu_lower : float
         Peak lower bound for the structure as given (real blocks real); a
         perturbation achieving it is ``sweep.lower_delta``.
@@ -659,11 +662,13 @@ def _local_maxima(values, count):
     return sorted(pk, key=lambda i: -v[i])[:count]
 
 
-def _around_peaks(w, values, npeaks: int, points: int) -> list:
+def _around_peaks(w, values, npeaks: int, points: int, floor: float = -np.inf) -> list:
     """``points`` log-spaced frequencies strictly between the neighbours of each of the
-    ``npeaks`` largest local maxima of ``values`` on the grid ``w``."""
+    ``npeaks`` largest local maxima of ``values`` on the grid ``w`` (those at least ``floor``)."""
     out = []
     for i in _local_maxima(values, npeaks):
+        if values[i] < floor:
+            break
         a, b = w[max(i - 1, 0)], w[min(i + 1, w.size - 1)]
         if b > a:
             out.append(np.logspace(np.log10(a), np.log10(b), points + 2)[1:-1])
@@ -699,28 +704,63 @@ def _fine_sweep(CL, S: BlockStructure, omega, npeaks: int = 4, rounds: int = 3, 
                    float("nan"), float("nan"), None, ["osborne"] * w.size), H
 
 
-def _dg_peak(H, S: BlockStructure, upper) -> tuple[float, int]:
-    """Peak over the grid of min(D-G bound, complex bound ``upper``), both certified at each
-    frequency.  The D-G bound (``mutext.mu.mu_upper(method="fast")``) is computed from the
-    largest complex values down, until the next complex value cannot raise the peak.  Where
-    the complex bound is flat (an equalised D-K loop) that is every frequency of the flat
-    part: stopping earlier would report the complex value of a frequency whose D-G bound is
-    lower, and miss the gain of a controller that exploits the real parameters.
-    Returns the peak and its index in the grid."""
-    order = np.argsort(-np.asarray(upper))
-    best, at = 0.0, int(order[0])
-    for k in order:
+def _dg_values(H, S: BlockStructure, upper) -> np.ndarray:
+    """min(D-G bound, complex bound ``upper``) over the grid, both certified at each frequency,
+    where it can decide the peak (zero elsewhere).  The D-G bound
+    (``mutext.mu.mu_upper(method="fast")``) is computed from the largest complex values down,
+    until the next complex value cannot raise the peak.  Where the complex bound is flat (an
+    equalised D-K loop) that is every frequency of the flat part: stopping earlier would report
+    the complex value of a frequency whose D-G bound is lower, and miss the gain of a controller
+    that exploits the real parameters."""
+    dg = np.zeros(len(upper))
+    best = 0.0
+    for k in np.argsort(-np.asarray(upper)):
         if upper[k] <= best:
             break
-        v = min(mu_upper(H[k], S, method="fast").value, float(upper[k]))
-        if v > best:
-            best, at = v, int(k)
-    return float(best), at
+        dg[k] = min(mu_upper(H[k], S, method="fast").value, float(upper[k]))
+        best = max(best, dg[k])
+    return dg
+
+
+def _dg_peak(H, S: BlockStructure, upper) -> tuple[float, int]:
+    """Peak over the grid of :func:`_dg_values` and its index in the grid."""
+    dg = _dg_values(H, S, upper)
+    k = int(np.argmax(dg))
+    return float(dg[k]), k
+
+
+def _dg_refined_peak(CL, H, S: BlockStructure, omega, upper, npeaks: int = 16,
+                     within=(0.02, 0.002), points: int = 8) -> tuple[float, float, np.ndarray]:
+    """The D-G peak of :func:`_dg_peak` with the local maxima of the D-G bound refined: in
+    round ``r``, ``points`` frequencies between the neighbours of each local maximum within
+    ``within[r]`` of the peak (at most ``npeaks``).  A controller that exploits the real
+    parameters equalises the D-G bound, so many local maxima are nearly equal and the true
+    peak can lie between the points of a grid refined around the complex bound's peaks;
+    each round shrinks the spacing there by ``points + 1``, and a smooth peak's error by
+    its square.  Returns the peak, its frequency and the frequencies added."""
+    w = np.asarray(omega, float)
+    dg = _dg_values(H, S, upper)
+    added = []
+    for tol in within:
+        new = _around_peaks(w, dg, npeaks, points, floor=dg.max() * (1.0 - tol))
+        wn = np.setdiff1d(np.concatenate(new), w) if new else np.zeros(0)
+        if wn.size == 0:
+            break
+        Hn = np.moveaxis(freqresp(CL, wn), -1, 0)
+        dn = np.array([mu_upper(h, S, method="fast").value for h in Hn])
+        added.append(wn)
+        w, dg = np.concatenate([w, wn]), np.concatenate([dg, dn])
+        o = np.argsort(w)
+        w, dg = w[o], dg[o]
+    k = int(np.argmax(dg))
+    return float(dg[k]), float(w[k]), (np.concatenate(added) if added else np.zeros(0))
 
 
 def _final_analysis(CL, S: BlockStructure, grid, final_points: int, dg: bool, npeaks: int = 4,
                     report=None):
-    """Certified complex upper bound on a fine grid, lower bounds at the peaks and the D-G bound."""
+    """Certified complex upper bound on a fine grid, lower bounds at the peaks and the D-G bound
+    (refined around its own peaks).  Returns the complex sweep, the real and complex lower
+    bounds, the D-G peak and the frequencies added for it."""
     report = report or (lambda stage, fraction: None)
     Sc = S.complexified()
     fine = np.unique(np.concatenate([default_grid(CL, n=final_points, decades=1.5), grid]))
@@ -729,13 +769,13 @@ def _final_analysis(CL, S: BlockStructure, grid, final_points: int, dg: bool, np
     ups = final.upper
     wpk = final.omega[_local_maxima(ups, npeaks)]
     mu_dg = float(final.peak_upper)
-    wreal = wpk
+    wreal, extra = wpk, np.zeros(0)
     if S.has_real and dg:
         report("final-analysis: D-G bound", 0.4)
-        mu_dg, k = _dg_peak(H, S, ups)
+        mu_dg, w_dg, extra = _dg_refined_peak(CL, H, S, final.omega, ups)
         # the real lower bound also where the D-G bound peaks: a loop that uses the
         # parameters' realness has its complex peaks elsewhere
-        wreal = np.union1d(wpk, final.omega[k:k + 1])
+        wreal = np.union1d(wpk, [w_dg])
     report("final-analysis: lower bounds at the peaks", 0.7)
     low_c = mu_sweep(CL, Sc, wpk, method="osborne", lower="all", refine=False)
     low = mu_sweep(CL, S, wreal, method="osborne", lower="all", refine=False) if S.has_real else low_c
@@ -744,7 +784,7 @@ def _final_analysis(CL, S: BlockStructure, grid, final_points: int, dg: bool, np
     final.peak_lower = float(low.peak_lower)
     final.lower_frequency = float(low.lower_frequency)
     final.lower_delta = low.lower_delta
-    return final, float(low.peak_lower), float(low_c.peak_lower), mu_dg
+    return final, float(low.peak_lower), float(low_c.peak_lower), mu_dg, extra
 
 
 def dk_iteration(P, structure: BlockStructure, nmeas: int, ncon: int, *, omega=None,
@@ -1058,7 +1098,7 @@ def _dk(P, S, nmeas, ncon, grid, max_iter, max_order, budget, fit_tol, rel_impro
                      f"left out of the D-step grid (from {grid.min():.3g} rad/s), covered by the final "
                      f"analysis; the closed loop of the plant as given is "
                      f"{'stable' if max_re < 0 else 'NOT stable'} (largest pole real part {max_re:.3g})")
-    final, low, low_c, mu_dg = _final_analysis(CL, S, grid, final_points, dg,
+    final, low, low_c, mu_dg, _ = _final_analysis(CL, S, grid, final_points, dg,
                                                report=lambda stage, f: report(stage, 0.9 + 0.1 * f))
     report("final-analysis: done", 1.0)
     _print(out, f"best: iteration {best_it}, controller order {K.nstates}; fine grid: "
@@ -1399,23 +1439,49 @@ class _DGPoint:
         return self.R @ (M.conj().T @ self.Dl @ M + 1j * (self.G @ M - M.conj().T @ self.G.conj().T)) @ self.R
 
 
+def _floored_scalings(Dl, Dr, S: BlockStructure, floor: float = 1e-8):
+    """The D scalings with each block's eigenvalues raised to at least ``floor`` times the
+    largest, in D_l and D_r alike (so still a valid pair).  Where a parameter barely matters
+    its optimal scaling tends to zero, D_r^(-1/2) to 1e8 and beyond, and the scaled form Q
+    to entries of 1e16 whose eigenvalues no longer have a correct digit."""
+    Dl, Dr = Dl.copy(), Dr.copy()
+    top = np.linalg.eigvalsh(Dr).max()
+    for b, rs, cs in zip(S.blocks, S.row_slices, S.col_slices):
+        ev, V = np.linalg.eigh(Dr[rs, rs])
+        if ev.min() >= floor * top:
+            continue
+        if b.kind == "full":
+            d = max(float(ev.mean()), floor * top)
+            Dr[rs, rs] = d * np.eye(b.rows)
+            Dl[cs, cs] = d * np.eye(b.cols)
+        else:
+            Dk = (V * np.maximum(ev, floor * top)) @ V.conj().T
+            Dr[rs, rs] = Dk
+            Dl[cs, cs] = Dk
+    return Dl, Dr
+
+
 def _dg_point(M, S: BlockStructure) -> _DGPoint:
     """D-G scalings of one frequency: the fast descent's, or the LMI's where those do not
-    reproduce the fast value to 1e-3.  The value is sqrt(lambda_max(Q)) for the scalings
-    kept, so certified by them."""
+    reproduce the fast value to 1e-3, their small D blocks floored (:func:`_floored_scalings`)
+    unless that loses the 1e-3.  The value is sqrt(lambda_max(Q)) for the scalings kept, so
+    certified by them."""
     for method in ("fast", "lmi"):
         u = mu_upper(M, S, method=method)
         if u.Dl is None:          # one full block: sigma_max is mu
             nr, nc = M.shape[1], M.shape[0]
-            pt = _DGPoint(u.value, np.eye(nc), np.eye(nr), np.zeros((nr, nc)))
+            tries = [_DGPoint(u.value, np.eye(nc), np.eye(nr), np.zeros((nr, nc)))]
         else:
-            ev, V = np.linalg.eigh(u.Dr)
-            R = (V * ev ** -0.5) @ V.conj().T
-            pt = _DGPoint(u.value, u.Dl, R, np.zeros_like(u.Dl) if u.G is None else u.G)
-        lam = np.linalg.eigvalsh(pt.q(M))[-1]
-        if lam <= u.value ** 2 * (1.0 + 1e-3):
-            pt.value = float(np.sqrt(max(lam, 0.0)))
-            return pt
+            tries = []
+            for Dl, Dr in (_floored_scalings(u.Dl, u.Dr, S), (u.Dl, u.Dr)):
+                ev, V = np.linalg.eigh(Dr)
+                R = (V * ev ** -0.5) @ V.conj().T
+                tries.append(_DGPoint(u.value, Dl, R, np.zeros_like(Dl) if u.G is None else u.G))
+        for pt in tries:
+            lam = np.linalg.eigvalsh(pt.q(M))[-1]
+            if lam <= u.value ** 2 * (1.0 + 1e-3):
+                pt.value = float(np.sqrt(max(lam, 0.0)))
+                return pt
     raise SolverError(f"no consistent D-G scalings for a {M.shape[0]}x{M.shape[1]} loop matrix")
 
 
@@ -1533,9 +1599,15 @@ def refine_controller(P, structure: BlockStructure, K, nmeas: int, ncon: int, *,
     controller (new scalings where the old ones could decide the peak) falls:
     the result is never worse than the controller given (the two are also
     compared on the fine grid of the final analysis, and the controller given
-    is returned if it is lower there).  Every
-    ``regrid_every`` accepted steps the grid is refined around the largest
-    local maxima, where a step may have raised a peak between grid points.
+    is returned if it is lower there).  A step can push a narrow peak up
+    between grid points, so the grid follows the peaks: it starts with the
+    fine grid of the controller given, each candidate is also evaluated
+    halfway between its four largest local maxima and their neighbours (a
+    probe above the old peak rejects the step and joins the grid), every
+    ``regrid_every`` accepted steps the grid is refined around the ten largest
+    local maxima, and when the fine grid of the final analysis finds a peak
+    the refinement grid missed, its frequencies join the grid and the descent
+    goes on with the steps left.
 
     This is a local descent on a non-smooth function (the peak over
     frequencies and over eigenvalues), in the spirit of the non-smooth
@@ -1643,74 +1715,122 @@ def refine_controller(P, structure: BlockStructure, K, nmeas: int, ncon: int, *,
         F = np.moveaxis(freqresp(CLa, w), -1, 0)
         return stable, F[:, :nc, :nr], F[:, :nc, nr:], F[:, nc:, :nr]
 
-    w = usable(w)
-    _, M, U, V = evaluate(theta, w)
-    pts = _dg_points(M, S)
-    start = max(p.value for p in pts)
-    history, notes = [], []
-    rho, accepted = 1e-3, 0
-    _print(out, f"{'step':>4} {'mu D-G (grid)':>14} {'model':>9} {'rho':>9} {'':>8} {'grid':>5} {'seconds':>8}")
-    with blas_single_thread():
-        for step in range(1, max_steps + 1):
-            if time_limit is not None and time.perf_counter() - t0 > time_limit:
-                notes.append(f"refine: time limit of {time_limit:g} s reached after {step - 1} steps")
-                break
-            if progress is not None:
-                progress(f"refine step {step}/{max_steps}: mu D-G {max(p.value for p in pts):.5f}, "
-                         f"{w.size} frequencies", 0.95 * (step - 1) / max_steps)
-            ti = time.perf_counter()
-            peak = max(p.value for p in pts)
-            Kw, Cr, Br = modal.response(theta, 1j * w)
-            res = _refine_step(modal, theta, pts, M, U, V, Kw, Cr, Br, rho)
-            ok = False
-            model = float("nan")
-            if res is not None:
-                dstep, tau, lam_peak = res
-                model = float(np.sqrt(max(tau, 0.0)))
-                pred = lam_peak - tau
-                if pred > 1e-12 * lam_peak:
-                    cand = theta + modal.scale * dstep
-                    st, Mn, Un, Vn = evaluate(cand, w)
-                    if st:
-                        new = _dg_points(Mn, S, pts, reject_at=peak * (1.0 - 1e-9))
-                        vn = np.inf if new is None else max(p.value for p in new)
-                        if vn < peak * (1.0 - 1e-9):
-                            ok = True
-                            ratio = (peak ** 2 - vn ** 2) / pred
-                            theta, M, U, V, pts = cand, Mn, Un, Vn, new
-                            rho = min(2.0 * rho, 0.2) if ratio > 0.5 else (rho / 2.0 if ratio < 0.1 else rho)
-            if not ok:
-                rho /= 4.0
-            else:
-                accepted += 1
-            mu_now = max(p.value for p in pts)
-            history.append({"step": step, "mu_dg": mu_now, "model": model, "rho": rho, "accepted": ok,
-                            "grid_points": int(w.size), "seconds": time.perf_counter() - ti})
-            _print(out, f"{step:>4} {mu_now:>14.6f} {model:>9.5f} {rho:>9.2e} {'accepted' if ok else 'rejected':>8} "
-                        f"{w.size:>5} {time.perf_counter() - ti:>8.2f}")
-            if ok and accepted % regrid_every == 0:
-                extra = _around_peaks(w, np.array([p.value for p in pts]), 10, 6)
-                w = usable(np.unique(np.concatenate([w] + extra)))
-                _, M, U, V = evaluate(theta, w)
-                pts = _dg_points(M, S)
-            if rho < 1e-7:
-                notes.append(f"refine: stopped at step {step}, no model step lowers the bound (trust region {rho:.1e})")
-                break
+    def at(th, wp):
+        """(M, U, V, scalings) of the loop with parameters ``th`` at the frequencies ``wp``."""
+        _, Mp, Up, Vp = evaluate(th, wp)
+        return Mp, Up, Vp, _dg_points(Mp, S)
+
+    def probes(w, pts):
+        """Frequencies halfway (in log) between the largest local maxima and their neighbours."""
+        idx = _local_maxima([p.value for p in pts], 4)
+        wp = [np.sqrt(w[i] * w[j]) for i in idx for j in (i - 1, i + 1) if 0 <= j < w.size]
+        return usable(np.setdiff1d(np.unique(wp), w)) if wp else np.zeros(0)
+
+    def merge(w, data, wp, extra):
+        """The grid and its data with the frequencies ``wp`` and their data added, in order."""
+        order = np.argsort(np.concatenate([w, wp]))
+        M, U, V, pts = data
+        Mp, Up, Vp, pp = extra
+        out = [np.concatenate([a, b])[order] for a, b in ((w, wp), (M, Mp), (U, Up), (V, Vp))]
+        allpts = list(pts) + list(pp)
+        return out[0], out[1], out[2], out[3], [allpts[i] for i in order]
+
     def analysed(Kx, part):
         CLx = lft_lower(P, Kx, nmeas, ncon)
         rep = None if progress is None else (lambda stage, f: progress(stage, part[0] + (part[1] - part[0]) * f))
         return CLx, _final_analysis(CLx, S, _default_dk_grid(P, 80), 200, True, report=rep)
 
-    Kr = modal.ss(theta)
-    CL, (final, low, low_c, mu_dg) = analysed(Kr, (0.95, 0.98))
-    if accepted:
-        # the steps are judged on the refinement grid; the controller given is judged on the
-        # same fine grid as the result, so that the result is never worse there either
-        CLg, fin_g = analysed(K, (0.98, 1.0))
-        if fin_g[3] < mu_dg:
-            notes.append(f"refine: on the final grid the refined loop ({mu_dg:.5f}) is not below the loop "
-                         f"given ({fin_g[3]:.5f}): the controller given is returned")
-            Kr, CL, (final, low, low_c, mu_dg) = K, CLg, fin_g
+    # the controller given, on the fine grid of the final analysis: its frequencies join the
+    # refinement grid (they hold the fine points around its peaks), and the result is compared
+    # with it on that same grid at the end, so that it is never worse there
+    CLg, fin_g = analysed(K, (0.0, 0.05))
+    w = usable(np.unique(np.concatenate([w, fin_g[0].omega, fin_g[4]])))
+    _, M, U, V = evaluate(theta, w)
+    pts = _dg_points(M, S)
+    start = max(p.value for p in pts)
+    history, notes = [], []
+    rho, accepted, step, stalled = 1e-3, 0, 0, False
+    _print(out, f"{'step':>4} {'mu D-G (grid)':>14} {'model':>9} {'rho':>9} {'':>8} {'grid':>5} {'seconds':>8}")
+    for check in range(4):
+        with blas_single_thread():
+            while step < max_steps:
+                if time_limit is not None and time.perf_counter() - t0 > time_limit:
+                    notes.append(f"refine: time limit of {time_limit:g} s reached after {step} steps")
+                    stalled = True
+                    break
+                step += 1
+                if progress is not None:
+                    progress(f"refine step {step}/{max_steps}: mu D-G {max(p.value for p in pts):.5f}, "
+                             f"{w.size} frequencies", 0.05 + 0.88 * (step - 1) / max_steps)
+                ti = time.perf_counter()
+                peak = max(p.value for p in pts)
+                Kw, Cr, Br = modal.response(theta, 1j * w)
+                res = _refine_step(modal, theta, pts, M, U, V, Kw, Cr, Br, rho)
+                ok = missed = False
+                model = float("nan")
+                if res is not None:
+                    dstep, tau, lam_peak = res
+                    model = float(np.sqrt(max(tau, 0.0)))
+                    pred = lam_peak - tau
+                    if pred > 1e-12 * lam_peak:
+                        cand = theta + modal.scale * dstep
+                        st, Mn, Un, Vn = evaluate(cand, w)
+                        if st:
+                            new = _dg_points(Mn, S, pts, reject_at=peak * (1.0 - 1e-9))
+                            vn = np.inf if new is None else max(p.value for p in new)
+                            if vn < peak * (1.0 - 1e-9):
+                                # a step may push a narrow peak up between grid points: probe
+                                # between the largest local maxima and their neighbours
+                                wp = probes(w, new)
+                                probed = at(cand, wp) if wp.size else None
+                                if probed and max(p.value for p in probed[3]) >= peak * (1.0 - 1e-9):
+                                    # rejected, and the grid keeps the probes (with this loop's data)
+                                    w, M, U, V, pts = merge(w, (M, U, V, pts), wp, at(theta, wp))
+                                    missed = True
+                                else:
+                                    ok = True
+                                    ratio = (peak ** 2 - vn ** 2) / pred
+                                    theta, w, M, U, V, pts = cand, w, Mn, Un, Vn, new
+                                    if probed:
+                                        w, M, U, V, pts = merge(w, (M, U, V, pts), wp, probed)
+                                    rho = min(2.0 * rho, 0.2) if ratio > 0.5 else (rho / 2.0 if ratio < 0.1 else rho)
+                if not ok:
+                    rho /= 2.0 if missed else 4.0
+                else:
+                    accepted += 1
+                mu_now = max(p.value for p in pts)
+                history.append({"step": step, "mu_dg": mu_now, "model": model, "rho": rho, "accepted": ok,
+                                "grid_points": int(w.size), "seconds": time.perf_counter() - ti})
+                _print(out, f"{step:>4} {mu_now:>14.6f} {model:>9.5f} {rho:>9.2e} "
+                            f"{'accepted' if ok else 'rejected':>8} {w.size:>5} {time.perf_counter() - ti:>8.2f}")
+                if ok and accepted % regrid_every == 0:
+                    extra = _around_peaks(w, np.array([p.value for p in pts]), 10, 6)
+                    w = usable(np.unique(np.concatenate([w] + extra)))
+                    _, M, U, V = evaluate(theta, w)
+                    pts = _dg_points(M, S)
+                if rho < 1e-7:
+                    notes.append(f"refine: stopped at step {step}, no model step lowers the bound "
+                                 f"(trust region {rho:.1e})")
+                    stalled = True
+                    break
+        Kr = modal.ss(theta)
+        f = 0.05 + 0.88 * step / max_steps     # the bar holds while the fine grid is checked
+        CL, (final, low, low_c, mu_dg, extra) = analysed(Kr, (f, f))
+        on_grid = max(p.value for p in pts)
+        if stalled or step >= max_steps or mu_dg <= on_grid * (1.0 + 1e-6):
+            break
+        # the fine grid found a peak the refinement grid missed (a step raised the bound
+        # between its points): its frequencies join the grid and the descent goes on
+        notes.append(f"refine: after step {step} the fine grid found {mu_dg:.5f} where the refinement grid "
+                     f"had {on_grid:.5f}; its {final.omega.size} frequencies were added")
+        w = usable(np.unique(np.concatenate([w, final.omega, extra])))
+        _, M, U, V = evaluate(theta, w)
+        pts = _dg_points(M, S)
+        rho = max(rho, 1e-4)
+    if accepted and fin_g[3] < mu_dg:
+        notes.append(f"refine: on the final grid the refined loop ({mu_dg:.5f}) is not below the loop "
+                     f"given ({fin_g[3]:.5f}): the controller given is returned")
+        Kr, CL, (final, low, low_c, mu_dg, _) = K, CLg, fin_g
     cl_poles = np.linalg.eigvals(np.asarray(CL.A, float)) if CL.nstates else np.zeros(0)
     max_re = float(cl_poles.real.max()) if cl_poles.size else float("-inf")
     notes.append(f"refine: {accepted} of {len(history)} steps accepted; D-G bound on the refinement grid "
