@@ -1517,7 +1517,12 @@ def _refine_step(modal, theta, pts, M, U, V, Kw, Cr, Br, rho, band=0.01, gap=0.0
     lam, Y = np.linalg.eigh(Q)
     top = lam[:, -1]
     peak = top.max()
-    act = np.flatnonzero(top > peak * (1.0 - 2.0 * band))
+    # the local maxima within the band and their neighbours: an equalised bound has hundreds
+    # of points within it, but between its maxima they add nothing the maxima do not say
+    near = top > peak * (1.0 - 2.0 * band)
+    idx = [i for i in _local_maxima(top, top.size) if near[i]]
+    act = np.unique(np.clip(np.concatenate([np.asarray(idx, int) + k for k in (-1, 0, 1)]), 0, top.size - 1))
+    act = act[near[act]]
     nt = theta.size
     d = cp.Variable(nt)
     tau = cp.Variable()
@@ -1792,7 +1797,12 @@ def refine_controller(P, structure: BlockStructure, K, nmeas: int, ncon: int, *,
                                     ratio = (peak ** 2 - vn ** 2) / pred
                                     theta, w, M, U, V, pts = cand, w, Mn, Un, Vn, new
                                     if probed:
-                                        w, M, U, V, pts = merge(w, (M, U, V, pts), wp, probed)
+                                        # the grid keeps the probes near the new peak
+                                        near = np.flatnonzero([p.value >= 0.98 * vn for p in probed[3]])
+                                        if near.size:
+                                            w, M, U, V, pts = merge(w, (M, U, V, pts), wp[near],
+                                                                    tuple(x[near] for x in probed[:3])
+                                                                    + ([probed[3][i] for i in near],))
                                     rho = min(2.0 * rho, 0.2) if ratio > 0.5 else (rho / 2.0 if ratio < 0.1 else rho)
                 if not ok:
                     rho /= 2.0 if missed else 4.0
@@ -1805,9 +1815,9 @@ def refine_controller(P, structure: BlockStructure, K, nmeas: int, ncon: int, *,
                             f"{'accepted' if ok else 'rejected':>8} {w.size:>5} {time.perf_counter() - ti:>8.2f}")
                 if ok and accepted % regrid_every == 0:
                     extra = _around_peaks(w, np.array([p.value for p in pts]), 10, 6)
-                    w = usable(np.unique(np.concatenate([w] + extra)))
-                    _, M, U, V = evaluate(theta, w)
-                    pts = _dg_points(M, S)
+                    wn = usable(np.setdiff1d(np.concatenate(extra), w)) if extra else np.zeros(0)
+                    if wn.size:
+                        w, M, U, V, pts = merge(w, (M, U, V, pts), wn, at(theta, wn))
                 if rho < 1e-7:
                     notes.append(f"refine: stopped at step {step}, no model step lowers the bound "
                                  f"(trust region {rho:.1e})")
