@@ -66,10 +66,10 @@ dgk" "mutext dgk-demo"`` added (one run, 2 cores): D-G-K reached 1.0148 (16
 states, 35 s) and 1.0131 (20 states, 47 s) at 0.041 m, 1.1422 (16, 26 s) and
 1.1395 (20, 38 s) at 0.035 m, with complex bounds 0.4-0.8 % higher: those
 controllers use the parameters' realness.  Refining them (``mutext
-dgk-refine``) gave, with the same 20 states, 0.9900 at 0.041 m (125 s in all)
-and 1.1381 at 0.035 m (81 s) with 80 steps, and 0.9895 (397 s) and 1.1211
-(513 s) with ``--refine-steps 300`` (dkpy fixed in the same run: 1.0142, 36
-states, 55 s, and its panic at 0.035 m).
+dgk-refine``) with ``--refine-steps 300`` gave, with the same 20 states,
+0.9895 at 0.041 m (870 s in all) and 1.1167 at 0.035 m (736 s), the refined
+loops' own reports equal to these verdicts (dkpy fixed in the same run:
+1.0142, 36 states, 73 s, and its panic at 0.035 m).
 
 Usage::
 
