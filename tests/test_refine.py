@@ -161,44 +161,25 @@ def test_refine_bad_inputs():
         refine_controller(P, S, K, 2, 1)
 
 
-def _ab13md_refined_peak(CL, omega, kinds, npeaks=4, iterations=30):
-    """AB13MD's peak on ``omega`` with its ``npeaks`` largest local maxima refined by golden
-    section (independent of mutext: dense complex solves, SLICOT)."""
-    v = ab13md_sweep(CL, omega, kinds)
-    best = v.max()
-    inner = [i for i in range(1, v.size - 1) if v[i] >= v[i - 1] and v[i] >= v[i + 1]]
-    g = (np.sqrt(5.0) - 1.0) / 2.0
-    for i in sorted(inner, key=lambda i: -v[i])[:npeaks]:
-        a, b = np.log(omega[i - 1]), np.log(omega[i + 1])
-        f = lambda x: ab13md_sweep(CL, [np.exp(x)], kinds)[0]
-        c, d = b - g * (b - a), a + g * (b - a)
-        fc, fd = f(c), f(d)
-        for _ in range(iterations):
-            if fc > fd:
-                b, d, fd = d, c, fc
-                c = b - g * (b - a)
-                fc = f(c)
-            else:
-                a, c, fc = c, d, fd
-                d = a + g * (b - a)
-                fd = f(d)
-        best = max(best, fc, fd)
-    return best
-
-
 def test_final_analysis_finds_the_dg_peak_between_grid_points():
     """A 20-state controller refined at 0.035 m (tests/data) equalises the D-G bound: its local
     maxima lie within 0.5 % of each other, and the highest (1.1213 near 89 rad/s) lies between
     the points of the grid refined around the complex bound's peaks, where the bound reads
     1.1165.  The reported peak is AB13MD's on a dense grid with its maxima refined, to 1e-4,
     and the real lower bound, taken at the reported peak, meets it."""
+    import sys
+    from pathlib import Path
+    sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "benchmarks"))
+    from _independent import mu_peak          # the benchmark's judge: AB13MD, golden section
     from mutext.dk import _default_dk_grid, _final_analysis
-    z = np.load(__file__.rsplit("/", 1)[0] + "/data/two_mass_equalised_dg.npz")
+    from mu_cases import ab13md_structure
+    z = np.load(Path(__file__).parent / "data" / "two_mass_equalised_dg.npz")
     P = tmu.plant(0.035)
     CL = ct.ss(P).lft(ct.ss(z["A"], z["B"], z["C"], z["D"]), nu=1, ny=1)
     assert np.linalg.eigvals(CL.A).real.max() < 0
     final, low, _, mu_dg, added = _final_analysis(CL, tmu.structure(), _default_dk_grid(P, 80), 200, True)
-    ref = _ab13md_refined_peak(CL, np.logspace(-3, 3, 1200), TWO_MASS_KINDS)
+    _, nblock, itype = ab13md_structure(TWO_MASS_KINDS)
+    ref, _ = mu_peak(CL, nblock, itype, np.logspace(-3, 3, 1200))
     assert ref > 1.12
     assert mu_dg == pytest.approx(ref, rel=1e-4)
     # the complex grid alone misses it by far more than that
@@ -217,7 +198,8 @@ def test_scalings_of_a_parameter_that_barely_matters_stay_usable():
     from slycot import ab13md
     from mutext.dk import _dg_point
     from mu_cases import ab13md_structure
-    M = np.load(__file__.rsplit("/", 1)[0] + "/data/two_mass_loop_matrix_tiny_scaling.npy")
+    from pathlib import Path
+    M = np.load(Path(__file__).parent / "data" / "two_mass_loop_matrix_tiny_scaling.npy")
     _, nblock, itype = ab13md_structure(TWO_MASS_KINDS)
     pt = _dg_point(M, tmu.structure())
     Q = pt.q(M)
