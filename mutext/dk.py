@@ -1753,8 +1753,7 @@ def refine_controller(P, structure: BlockStructure, K, nmeas: int, ncon: int, *,
     # with it on that same grid at the end, so that it is never worse there
     CLg, fin_g = analysed(K, (0.0, 0.05))
     w = usable(np.unique(np.concatenate([w, fin_g[0].omega, fin_g[4]])))
-    _, M, U, V = evaluate(theta, w)
-    pts = _dg_points(M, S)
+    M, U, V, pts = at(theta, w)
     start = max(p.value for p in pts)
     history, notes = [], []
     rho, accepted, step, stalled = 1e-3, 0, 0, False
@@ -1798,7 +1797,7 @@ def refine_controller(P, structure: BlockStructure, K, nmeas: int, ncon: int, *,
                                 else:
                                     ok = True
                                     ratio = (peak ** 2 - vn ** 2) / pred
-                                    theta, w, M, U, V, pts = cand, w, Mn, Un, Vn, new
+                                    theta, M, U, V, pts = cand, Mn, Un, Vn, new
                                     if probed:
                                         # the grid keeps the probes near the new peak
                                         near = np.flatnonzero([p.value >= 0.98 * vn for p in probed[3]])
@@ -1837,8 +1836,7 @@ def refine_controller(P, structure: BlockStructure, K, nmeas: int, ncon: int, *,
         notes.append(f"refine: after step {step} the fine grid found {mu_dg:.5f} where the refinement grid "
                      f"had {on_grid:.5f}; its {final.omega.size} frequencies were added")
         w = usable(np.unique(np.concatenate([w, final.omega, extra])))
-        _, M, U, V = evaluate(theta, w)
-        pts = _dg_points(M, S)
+        M, U, V, pts = at(theta, w)
         rho = max(rho, 1e-4)
     if accepted and fin_g[3] < mu_dg:
         notes.append(f"refine: on the final grid the refined loop ({mu_dg:.5f}) is not below the loop "
