@@ -676,6 +676,30 @@ def _around_peaks(w, values, npeaks: int, points: int, floor: float = -np.inf) -
     return out
 
 
+def _refine_around_maxima(w, data, evaluate, rounds, points: int):
+    """The grid ``w`` (sorted) and the arrays ``data`` on it (``data[0]`` the values), with
+    ``points`` log-spaced frequencies added between the neighbours of local maxima, round by
+    round: ``rounds`` holds ``(npeaks, within)``, the ``npeaks`` largest maxima at least
+    ``1 - within`` times the peak (``within=None``: all of them).  ``evaluate(wn)`` returns the
+    data at new frequencies.  Each round shrinks the spacing at a maximum by ``points + 1``,
+    and a smooth peak's error by its square.  Returns the grid, the data and the frequencies
+    added."""
+    added = []
+    for npeaks, within in rounds:
+        values = data[0]
+        floor = -np.inf if within is None else values.max() * (1.0 - within)
+        new = _around_peaks(w, values, npeaks, points, floor=floor)
+        wn = np.setdiff1d(np.concatenate(new), w) if new else np.zeros(0)
+        if wn.size == 0:
+            break
+        dn = evaluate(wn)
+        added.append(wn)
+        order = np.argsort(np.concatenate([w, wn]))
+        w = np.concatenate([w, wn])[order]
+        data = tuple(np.concatenate([a, b])[order] for a, b in zip(data, dn))
+    return w, data, (np.concatenate(added) if added else np.zeros(0))
+
+
 def _fine_sweep(CL, S: BlockStructure, omega, npeaks: int = 4, rounds: int = 3, points: int = 16,
                 progress=None) -> tuple[MuSweep, np.ndarray]:
     """Diagonal-D upper bound on ``omega`` with its largest local maxima refined:
@@ -685,21 +709,12 @@ def _fine_sweep(CL, S: BlockStructure, omega, npeaks: int = 4, rounds: int = 3, 
     w = np.unique(np.asarray(omega, float))
     H = np.moveaxis(freqresp(CL, w), -1, 0)
     up, X = _sweep_upper(H, S, progress=progress)
-    for _ in range(rounds):
-        new = _around_peaks(w, up, npeaks, points)
-        if not new:
-            break
-        wn = np.setdiff1d(np.concatenate(new), w)
-        if wn.size == 0:
-            break
+
+    def evaluate(wn):
         Hn = np.moveaxis(freqresp(CL, wn), -1, 0)
-        upn, Xn = _sweep_upper(Hn, S)
-        w = np.concatenate([w, wn])
-        up = np.concatenate([up, upn])
-        X = np.concatenate([X, Xn])
-        H = np.concatenate([H, Hn])
-        order = np.argsort(w)
-        w, up, X, H = w[order], up[order], X[order], H[order]
+        return (*_sweep_upper(Hn, S), Hn)
+
+    w, (up, X, H), _ = _refine_around_maxima(w, (up, X, H), evaluate, [(npeaks, None)] * rounds, points)
     k = int(np.argmax(up))
     return MuSweep(w, up, np.full(w.size, np.nan), np.exp(X), "osborne", float(up[k]), float(w[k]),
                    float("nan"), float("nan"), None, ["osborne"] * w.size), H
@@ -730,31 +745,22 @@ def _dg_peak(H, S: BlockStructure, upper) -> tuple[float, int]:
     return float(dg[k]), k
 
 
-def _dg_refined_peak(CL, H, S: BlockStructure, omega, upper, rounds=((0.02, 8), (0.002, 4)),
+def _dg_refined_peak(CL, H, S: BlockStructure, omega, upper, rounds=((8, 0.02), (4, 0.002)),
                      points: int = 6) -> tuple[float, float, np.ndarray]:
-    """The D-G peak of :func:`_dg_peak` with the local maxima of the D-G bound refined: in
-    each round ``(within, npeaks)``, ``points`` frequencies between the neighbours of each of
-    the ``npeaks`` largest local maxima within ``within`` of the peak.  A controller that exploits the real
-    parameters equalises the D-G bound, so many local maxima are nearly equal and the true
-    peak can lie between the points of a grid refined around the complex bound's peaks;
-    each round shrinks the spacing there by ``points + 1``, and a smooth peak's error by
-    its square.  Returns the peak, its frequency and the frequencies added."""
-    w = np.asarray(omega, float)
-    dg = _dg_values(H, S, upper)
-    added = []
-    for within, npeaks in rounds:
-        new = _around_peaks(w, dg, npeaks, points, floor=dg.max() * (1.0 - within))
-        wn = np.setdiff1d(np.concatenate(new), w) if new else np.zeros(0)
-        if wn.size == 0:
-            break
+    """The D-G peak of :func:`_dg_peak` with the local maxima of the D-G bound refined
+    (:func:`_refine_around_maxima`; by default the 8 largest within 2 % of the peak, then the
+    4 largest within 0.2 %).  A controller that exploits the real parameters equalises the
+    D-G bound, so many local maxima are nearly equal and the true peak can lie between the
+    points of a grid refined around the complex bound's peaks.  Returns the peak, its
+    frequency and the frequencies added."""
+    def evaluate(wn):
         Hn = np.moveaxis(freqresp(CL, wn), -1, 0)
-        dn = np.array([mu_upper(h, S, method="fast").value for h in Hn])
-        added.append(wn)
-        w, dg = np.concatenate([w, wn]), np.concatenate([dg, dn])
-        o = np.argsort(w)
-        w, dg = w[o], dg[o]
+        return (np.array([mu_upper(h, S, method="fast").value for h in Hn]),)
+
+    w, (dg,), added = _refine_around_maxima(np.asarray(omega, float), (_dg_values(H, S, upper),), evaluate,
+                                            rounds, points)
     k = int(np.argmax(dg))
-    return float(dg[k]), float(w[k]), (np.concatenate(added) if added else np.zeros(0))
+    return float(dg[k]), float(w[k]), added
 
 
 def _final_analysis(CL, S: BlockStructure, grid, final_points: int, dg: bool, npeaks: int = 4,
