@@ -1619,8 +1619,8 @@ def refine_controller(P, structure: BlockStructure, K, nmeas: int, ncon: int, *,
     probe above the old peak rejects the step and joins the grid), every
     ``regrid_every`` accepted steps the grid is refined around the ten largest
     local maxima, and when the fine grid of the final analysis finds a peak
-    the refinement grid missed, its frequencies join the grid and the descent
-    goes on with the steps left.
+    the refinement grid missed (by more than 0.01 %), its frequencies join the grid and the descent
+    goes on for ``regrid_every`` more steps (at most three times).
 
     This is a local descent on a non-smooth function (the peak over
     frequencies and over eigenvalues), in the spirit of the non-smooth
@@ -1644,16 +1644,20 @@ def refine_controller(P, structure: BlockStructure, K, nmeas: int, ncon: int, *,
         pole of ``P`` are left out (the loop is computed from its own
         realisation, so this only avoids ill-conditioned points).
     max_steps : int
-        Largest number of model steps (accepted or not).
+        Model steps (accepted or not) before the fine grid is checked; each
+        time it finds a peak the refinement grid missed (at most three times),
+        ``regrid_every`` more follow.
     time_limit : float, optional
         Seconds after which no new step is started.
     regrid_every : int
-        Accepted steps between grid refinements.
+        Accepted steps between grid refinements, and the steps added after a
+        missed peak.
     out : file or None
         Where to print one line per step.
     progress : callable, optional
-        ``progress(stage, fraction)`` once per step (steps share 0-0.95 of the
-        bar, the final analysis the rest).
+        ``progress(stage, fraction)`` once per step (the controller given's
+        analysis takes 0-0.05 of the bar, the steps 0.05-0.93, the final
+        analysis the rest).
 
     Returns
     -------
@@ -1662,7 +1666,9 @@ def refine_controller(P, structure: BlockStructure, K, nmeas: int, ncon: int, *,
         ``mu_lower`` and the other bounds from the same final analysis as
         :func:`dk_iteration` (a fine grid independent of the refinement grid),
         ``history`` one row per step (``step``, ``mu_dg`` on the refinement
-        grid, ``rho``, ``accepted``, ``grid_points``, ``seconds``).
+        grid, ``model`` the model's prediction, ``rho``, ``accepted``,
+        ``grid_points``, ``seconds``, ``round``: 0, then 1, 2, 3 after each
+        missed peak, whose frequencies can raise ``mu_dg``).
 
     Raises
     ------
@@ -1762,19 +1768,19 @@ def refine_controller(P, structure: BlockStructure, K, nmeas: int, ncon: int, *,
     M, U, V, pts = at(theta, w)
     start = max(p.value for p in pts)
     history, notes = [], []
-    rho, accepted, step, stalled = 1e-3, 0, 0, False
+    rho, accepted, step, timed_out, limit = 1e-3, 0, 0, False, max_steps
     _print(out, f"{'step':>4} {'mu D-G (grid)':>14} {'model':>9} {'rho':>9} {'':>8} {'grid':>5} {'seconds':>8}")
     for check in range(4):
         with blas_single_thread():
-            while step < max_steps:
+            while step < limit:
                 if time_limit is not None and time.perf_counter() - t0 > time_limit:
                     notes.append(f"refine: time limit of {time_limit:g} s reached after {step} steps")
-                    stalled = True
+                    timed_out = True
                     break
                 step += 1
                 if progress is not None:
-                    progress(f"refine step {step}/{max_steps}: mu D-G {max(p.value for p in pts):.5f}, "
-                             f"{w.size} frequencies", 0.05 + 0.88 * (step - 1) / max_steps)
+                    progress(f"refine step {step}/{limit}: mu D-G {max(p.value for p in pts):.5f}, "
+                             f"{w.size} frequencies", 0.05 + 0.88 * min(step - 1, max_steps) / max_steps)
                 ti = time.perf_counter()
                 peak = max(p.value for p in pts)
                 Kw, Cr, Br = modal.response(theta, 1j * w)
@@ -1818,7 +1824,8 @@ def refine_controller(P, structure: BlockStructure, K, nmeas: int, ncon: int, *,
                     accepted += 1
                 mu_now = max(p.value for p in pts)
                 history.append({"step": step, "mu_dg": mu_now, "model": model, "rho": rho, "accepted": ok,
-                                "grid_points": int(w.size), "seconds": time.perf_counter() - ti})
+                                "grid_points": int(w.size), "seconds": time.perf_counter() - ti,
+                                "round": check})
                 _print(out, f"{step:>4} {mu_now:>14.6f} {model:>9.5f} {rho:>9.2e} "
                             f"{'accepted' if ok else 'rejected':>8} {w.size:>5} {time.perf_counter() - ti:>8.2f}")
                 if ok and accepted % regrid_every == 0:
@@ -1829,21 +1836,22 @@ def refine_controller(P, structure: BlockStructure, K, nmeas: int, ncon: int, *,
                 if rho < 1e-7:
                     notes.append(f"refine: stopped at step {step}, no model step lowers the bound "
                                  f"(trust region {rho:.1e})")
-                    stalled = True
                     break
         Kr = modal.ss(theta)
-        f = 0.05 + 0.88 * step / max_steps     # the bar holds while the fine grid is checked
+        f = 0.05 + 0.88 * min(step, max_steps) / max_steps     # the bar holds while the fine grid is checked
         CL, (final, low, low_c, mu_dg, extra) = analysed(Kr, (f, f))
         on_grid = max(p.value for p in pts)
-        if stalled or step >= max_steps or mu_dg <= on_grid * (1.0 + 1e-6):
+        if timed_out or check == 3 or mu_dg <= on_grid * (1.0 + 1e-4):
             break
-        # the fine grid found a peak the refinement grid missed (a step raised the bound
-        # between its points): its frequencies join the grid and the descent goes on
+        # the fine grid found a peak the refinement grid missed by more than 0.01 % (a step
+        # raised the bound between its points, or beyond its ends): its frequencies join the grid and the descent goes on for
+        # ``regrid_every`` more steps, from a trust region that can still move
         notes.append(f"refine: after step {step} the fine grid found {mu_dg:.5f} where the refinement grid "
-                     f"had {on_grid:.5f}; its {final.omega.size} frequencies were added")
+                     f"had {on_grid:.5f}; its {final.omega.size} frequencies were added and "
+                     f"{regrid_every} more steps taken")
         w = usable(np.unique(np.concatenate([w, final.omega, extra])))
         M, U, V, pts = at(theta, w)
-        rho = max(rho, 1e-4)
+        rho, limit = max(rho, 1e-4), step + regrid_every
     if accepted and fin_g[3] < mu_dg:
         notes.append(f"refine: on the final grid the refined loop ({mu_dg:.5f}) is not below the loop "
                      f"given ({fin_g[3]:.5f}): the controller given is returned")
