@@ -97,8 +97,7 @@ PATIENT = {"fit_tol": 2e-4, "rel_improvement": 1e-4, "max_iter": 20, "patience":
 
 
 def problem(name):
-    """(plant, nmeas, ncon, mutext structure, dkpy block spec, grid for dkpy or None)."""
-    from mutext.mu import Block, BlockStructure
+    """(plant, nmeas, ncon, mutext structure, dkpy block spec, dkpy's grid, mutext's grid or None for its own)."""
     if name.startswith("two-mass-"):
         from mutext.dk import _default_dk_grid
         from mutext.examples import two_mass_uncertain as tmu
@@ -107,26 +106,28 @@ def problem(name):
         omega = np.logspace(np.log10(g.min()), np.log10(g.max()), GRID_N)
         return P, 1, 1, tmu.structure(), [(1, 1)] * 4 + [(2, 2)], omega, None
     if name == "skogestad":
-        import dkpy
-        eg = dkpy.example_skogestad2006_p325()
-        S = BlockStructure([Block.full(1, 1), Block.full(1, 1), Block.full(2, 2)])
+        # the same interconnection as dkpy.example_skogestad2006_p325 (tests/test_dk.py checks it
+        # against the textbook's transfer functions)
+        from mutext.examples import distillation
         omega = np.logspace(-3, 3, GRID_N)
-        return eg["P"], eg["n_y"], eg["n_u"], S, [(1, 1), (1, 1), (2, 2)], omega, omega
+        return distillation.plant(), 2, 2, distillation.structure(), [(1, 1), (1, 1), (2, 2)], omega, omega
     raise SystemExit(f"unknown problem {name!r}")
 
 
-#: steps of refine_controller in ``mutext dgk-refine`` (``--refine-steps``)
+#: steps of refine_controller in the ``-refine`` tools (``--refine-steps``)
 REFINE_STEPS = 80
 
 
 def run_mutext(name, config):
     from mutext.dk import dgk_iteration, dk_iteration
     P, ny, nu, S, _, _, omega = problem(name)
+    config = {"dgk-refine": "dgk-demo-refine"}.get(config, config)
+    refine = config.endswith("-refine")
+    config = config.removesuffix("-refine")
     real = config.startswith("dgk")
-    refine = config == "dgk-refine"
     if real and not S.has_real:
         raise RuntimeError("no real blocks: D-G-K is plain D-K here")
-    config = {"dgk": "default", "dgk-demo": "demo", "dgk-refine": "demo"}.get(config, config)
+    config = {"dgk": "default", "dgk-demo": "demo"}.get(config, config)
     opts = {"default": {}, "demo": {"max_states": P.nstates + 16}, "big": {"max_states": P.nstates + 20},
             "tight": {"max_states": P.nstates + 16, **TIGHT},
             "patient": {"max_states": P.nstates + 40, **PATIENT}}[config]
@@ -137,7 +138,8 @@ def run_mutext(name, config):
         from mutext.dk import refine_controller
         before = res.mu_upper_dg
         ref = refine_controller(P, S, res.K, ny, nu, max_steps=REFINE_STEPS)
-        note = (f"c = {res.real_scale:.3f}, D-G {before:.5f}; refined: "
+        scale = f"c = {res.real_scale:.3f}, " if real else ""
+        note = (f"{scale}from {before:.5f}; refined: "
                 f"{sum(h['accepted'] for h in ref.history)}/{len(ref.history)} steps accepted")
         return ref.K, ref.mu_upper_dg, time.perf_counter() - t0, note
     sec = time.perf_counter() - t0
@@ -207,28 +209,30 @@ def main(argv=None) -> int:
     ap.add_argument("--timeout", type=float, default=600.0, help="seconds per synthesis (default 600)")
     ap.add_argument("--problems", nargs="+", default=["two-mass-0.035", "two-mass-0.041", "skogestad"])
     ap.add_argument("--tools", nargs="+", help="a subset of the tools (e.g. 'mutext demo' 'dkpy auto')")
-    ap.add_argument("--refine-steps", type=int, default=80, help="steps of 'mutext dgk-refine' (default 80)")
+    ap.add_argument("--refine-steps", type=int, default=80,
+                    help="steps of refine_controller in the '-refine' tools (default 80)")
     args = ap.parse_args(argv)
     global REFINE_STEPS
     REFINE_STEPS = args.refine_steps
     from mutext.lti import ss
     try:
         import dkpy  # noqa: F401
-        tools = ["mutext default", "mutext demo", "mutext tight", "dkpy auto", "dkpy fixed"]
         have_dkpy = True
     except ImportError:
         have_dkpy = False
-        tools = ["mutext default", "mutext demo", "mutext tight"]
         print("note: dkpy is not installed (pip install dkpy); its columns are skipped", file=sys.stderr)
+    tools = ["mutext default", "mutext demo", "mutext tight", "dkpy auto", "dkpy fixed"]
     if args.tools:
-        tools = [t for t in tools + ["mutext big", "mutext patient", "mutext dgk", "mutext dgk-demo",
-                                     "mutext dgk-refine"]
-                 if t in args.tools]
+        configs = ["default", "demo", "tight", "big", "patient", "dgk", "dgk-demo"]
+        known = tools + [f"mutext {c}{r}" for c in configs for r in ("", "-refine")] + ["mutext dgk-refine"]
+        unknown = [t for t in args.tools if t not in known]
+        if unknown:
+            raise SystemExit(f"unknown tools {unknown}; known: {sorted(set(known))}")
+        tools = [t for t in dict.fromkeys(known) if t in args.tools]
+    if not have_dkpy:
+        tools = [t for t in tools if not t.startswith("dkpy")]
     rows = []
     for name in args.problems:
-        if name == "skogestad" and not have_dkpy:
-            print("note: the skogestad problem comes from dkpy; skipped", file=sys.stderr)
-            continue
         P, ny, nu, S, _, _, _ = problem(name)
         results = []
         for tool in tools:
@@ -240,10 +244,10 @@ def main(argv=None) -> int:
     print(f"verdicts: {indep.USED}")
     print("mu: AB13MD peak with the real parameters real (D-G scalings); mu C: with them complex "
           "(what the D-K iterations minimise); inf = closed loop not stable")
-    print(f"{'problem':<16} {'tool':<15} {'mu':>8} {'mu C':>8} {'mu (own)':>9} {'s':>7} {'order':>6}  note")
+    print(f"{'problem':<16} {'tool':<21} {'mu':>8} {'mu C':>8} {'mu (own)':>9} {'s':>7} {'order':>6}  note")
     for name, tool, mu, mu_c, own, sec, order, note in rows:
         o = "-" if order is None else str(order)
-        print(f"{name:<16} {tool:<15} {mu:>8.4f} {mu_c:>8.4f} {own:>9.4f} {sec:>7.1f} {o:>6}  {note}")
+        print(f"{name:<16} {tool:<21} {mu:>8.4f} {mu_c:>8.4f} {own:>9.4f} {sec:>7.1f} {o:>6}  {note}")
     return 0
 
 

@@ -11,6 +11,7 @@ from mu_cases import ab13md_sweep
 from mutext import cli
 from mutext.dk import DScaleFit, dk_iteration, fit_dscale, scaled_plant
 from mutext.errors import ModelError
+from mutext.examples import distillation
 from mutext.lti import freqresp, is_stable, lft_lower
 from mutext.mu import Block, BlockStructure, mu_sweep
 
@@ -318,27 +319,20 @@ def test_two_mass_mu_relaxed_bound_lowers_mu():
 # weights with near-axis poles: the distillation column ([SP] Table 8.1, sec. 8.12.4)
 # ----------------------------------------------------------------------------
 
-def distillation_plant():
-    """[SP] Table 8.1 as dkpy builds it (``example_skogestad2006_p325``): inputs
-    [u_Delta (2), w (2), u (2)], outputs [z_Delta (2), z_P (2), y (2)]; W_P = 0.5 (10 s + 1) /
-    (10 s + 1e-5), an integrator approximated by poles at -1e-6 rad/s."""
-    G0 = np.array([[87.8, -86.4], [108.2, -109.6]])
-    G = ct.append(ct.tf([1], [75, 1]), ct.tf([1], [75, 1])) * ct.tf(G0.reshape(2, 2, 1), np.ones((2, 2, 1)))
-    Wp = 0.5 * ct.append(ct.tf([10, 1], [10, 1e-5]), ct.tf([10, 1], [10, 1e-5]))
-    Wi = ct.append(ct.tf([1, 0.2], [0.5, 1]), ct.tf([1, 0.2], [0.5, 1]))
-    G.name, Wp.name, Wi.name = "G", "Wp", "Wi"
-    sum_w = ct.summing_junction(inputs=["u_w", "u_G"], dimension=2, name="sum_w")
-    sum_del = ct.summing_junction(inputs=["u_del", "u_u"], dimension=2, name="sum_del")
-    split = ct.summing_junction(inputs=["u"], dimension=2, name="split")
-    P = ct.interconnect([G, Wp, Wi, sum_w, sum_del, split],
-                        connections=[["G.u", "sum_del.y"], ["sum_del.u_u", "split.y"], ["sum_w.u_G", "G.y"],
-                                     ["Wp.u", "sum_w.y"], ["Wi.u", "split.y"]],
-                        inplist=["sum_del.u_del", "sum_w.u_w", "split.u"],
-                        outlist=["Wi.y", "Wp.y", "-sum_w.y"])
-    return ct.ss(P.A, P.B, P.C, P.D)
+DIST_S = distillation.structure()
 
 
-DIST_S = BlockStructure([Block.full(1, 1), Block.full(1, 1), Block.full(2, 2)])
+def test_distillation_plant_is_the_textbook_interconnection():
+    """[SP] Table 8.1 from its transfer functions, evaluated by numpy:
+    z_Delta = W_I u, z_P = W_P (G (u_Delta + u) + w), y = -(G (u_Delta + u) + w)."""
+    P = distillation.plant()
+    I, Z = np.eye(2), np.zeros((2, 2))
+    for s in 1j * np.array([1e-7, 3e-3, 0.37, 20.0]):
+        G = np.array([[87.8, -86.4], [108.2, -109.6]]) / (75 * s + 1)
+        Wi, Wp = (s + 0.2) / (0.5 * s + 1), 0.5 * (10 * s + 1) / (10 * s + 1e-5)
+        ref = np.block([[Z, Z, Wi * I], [Wp * G, Wp * I, Wp * G], [-G, -I, -G]])
+        np.testing.assert_allclose(P(s), ref, rtol=1e-10, atol=1e-10 * np.abs(ref).max())
+    assert [b.kind for b in DIST_S.blocks] == ["full"] * 3 and DIST_S.nrows == DIST_S.ncols == 4
 
 
 def _ab13md_peak(CL, omega):
@@ -348,7 +342,7 @@ def _ab13md_peak(CL, omega):
 
 def test_near_axis_poles_are_set_apart():
     from mutext.dk import _default_dk_grid, near_axis_poles
-    P = distillation_plant()
+    P = distillation.plant()
     np.testing.assert_allclose(np.sort(near_axis_poles(P).real), [-1e-6, -1e-6], rtol=1e-6)
     g = _default_dk_grid(P, 80)
     # the D-step grid spans the other poles (1/75 and 2 rad/s) 1.5 decades beyond, not 1e-6
@@ -363,7 +357,7 @@ def test_dk_on_a_weight_with_near_axis_poles():
     """The K step no longer fails with dynamic scalings; the verdict on the loop
     is independent of mutext: python-control's lft, numpy eigenvalues, AB13MD on a grid
     that reaches below the weight's poles."""
-    P = distillation_plant()
+    P = distillation.plant()
     res = dk_iteration(P, DIST_S, 2, 2, max_iter=2, out=None)
     assert any(h["orders"] != [0, 0] for h in res.history if h["controller_order"] is not None)
     assert not any("failed" in n for n in res.notes)
@@ -383,7 +377,7 @@ def test_dk_on_a_weight_with_near_axis_poles():
 def test_dk_distillation_beats_dkpy():
     """dkpy 0.1.9 reports about 1.035 with a 22-state controller on the same problem and grid;
     finer fits and more patience get below it with 18 states."""
-    P = distillation_plant()
+    P = distillation.plant()
     res = dk_iteration(P, DIST_S, 2, 2, omega=np.logspace(-3, 3, 61), fit_tol=5e-4, rel_improvement=1e-3,
                        max_iter=20, patience=2, max_states=22, out=None)
     CL = ct.ss(P).lft(ct.ss(res.K), nu=2, ny=2)
