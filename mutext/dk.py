@@ -1628,7 +1628,10 @@ def refine_controller(P, structure: BlockStructure, K, nmeas: int, ncon: int, *,
     the two-mass problem at 0.041 m, the 20-state D-G-K controller's 1.0131
     falls to 0.9896 in 100 steps, 163 s, and 0.9895 in 300, 870 s: the steps
     slow down as the grid grows around the peaks), and it stops at a local
-    minimum that depends on the path.
+    minimum that depends on the path.  With complex blocks only, ``G = 0`` and
+    the scalings are D-K's D scalings, held instead of fitted: on the
+    distillation column (:mod:`mutext.examples.distillation`) 80 steps take
+    the default D-K controller's 1.0501 to 0.9953, with the same 18 states.
 
     Parameters
     ----------
