@@ -1619,8 +1619,9 @@ def refine_controller(P, structure: BlockStructure, K, nmeas: int, ncon: int, *,
     probe above the old peak rejects the step and joins the grid), every
     ``regrid_every`` accepted steps the grid is refined around the ten largest
     local maxima, and when the fine grid of the final analysis finds a peak
-    the refinement grid missed (by more than 0.01 %), its frequencies join the grid and the descent
-    goes on for ``regrid_every`` more steps (at most three times).
+    the refinement grid missed (by more than 0.01 %), its frequencies join the
+    grid and the descent goes on for ``regrid_every`` more steps (at most three
+    times).
 
     This is a local descent on a non-smooth function (the peak over
     frequencies and over eigenvalues), in the spirit of the non-smooth
@@ -1847,11 +1848,12 @@ def refine_controller(P, structure: BlockStructure, K, nmeas: int, ncon: int, *,
         if timed_out or check == 3 or mu_dg <= on_grid * (1.0 + 1e-4):
             break
         # the fine grid found a peak the refinement grid missed by more than 0.01 % (a step
-        # raised the bound between its points, or beyond its ends): its frequencies join the grid and the descent goes on for
-        # ``regrid_every`` more steps, from a trust region that can still move
+        # raised the bound between its points, or beyond its ends): its frequencies join the
+        # grid and the descent goes on for ``regrid_every`` more steps, from a trust region
+        # that can still move
         notes.append(f"refine: after step {step} the fine grid found {mu_dg:.5f} where the refinement grid "
-                     f"had {on_grid:.5f}; its {final.omega.size} frequencies were added and "
-                     f"{regrid_every} more steps taken")
+                     f"had {on_grid:.5f}; its {final.omega.size} frequencies were added and up to "
+                     f"{regrid_every} more steps follow")
         w = usable(np.unique(np.concatenate([w, final.omega, extra])))
         M, U, V, pts = at(theta, w)
         rho, limit = max(rho, 1e-4), step + regrid_every
