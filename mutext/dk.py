@@ -1631,7 +1631,7 @@ def refine_controller(P, structure: BlockStructure, K, nmeas: int, ncon: int, *,
     frequencies and over eigenvalues), in the spirit of the non-smooth
     mu-synthesis of Apkarian and Noll [AN]_: progress is steady but slow (on
     the two-mass problem at 0.041 m, the 20-state D-G-K controller's 1.0131
-    falls to 0.9896 in 100 steps, 163 s, and 0.9895 in 300, 870 s: the steps
+    falls to 0.9896 in 100 steps, 163 s, and 0.9895 in 300, 607 s: the steps
     slow down as the grid grows around the peaks), and it stops at a local
     minimum that depends on the path.  With complex blocks only, ``G = 0`` and
     the scalings are D-K's D scalings, held instead of fitted: on the
