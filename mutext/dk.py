@@ -1515,11 +1515,12 @@ def _dg_points(Ms, S, old=None, reject_at=np.inf):
     return pts
 
 
-def _refine_step(modal, theta, pts, M, U, V, Kw, Cr, Br, rho, band=0.01, gap=0.02):
+def _refine_step(modal, theta, pts, M, U, V, Kw, Cr, Br, rho, w, band=0.01, gap=0.02, spread=120):
     """Trust-region model step: minimise max over the active frequencies of the linearised
     lambda_max of Q (on its top eigenspace), with every parameter moving at most ``rho`` of
-    its size and K(jw) at most ``rho`` of its norm at every frequency.  Returns the step
-    (in units of ``modal.scale``) and the predicted peak of lambda_max, or None."""
+    its size and K(jw) at most ``rho`` of its norm at the active frequencies and at ``spread``
+    frequencies spread evenly in log over the grid ``w``.  Returns the step (in units of
+    ``modal.scale``) and the predicted peak of lambda_max, or None."""
     import cvxpy as cp
     Q = np.array([p.q(m) for p, m in zip(pts, M)])
     lam, Y = np.linalg.eigh(Q)
@@ -1557,6 +1558,12 @@ def _refine_step(modal, theta, pts, M, U, V, Kw, Cr, Br, rho, band=0.01, gap=0.0
     cons = list(lmis)
     if lin_rows:
         cons.append(np.array(lin_rhs) + np.array(lin_rows) @ d <= tau)
+    # K(jw) moves smoothly between grid points: its trust region on a log-even subset of the
+    # grid (dense near the peaks) constrains the step as much, at a fraction of the cost
+    # (on the distillation column's 527 frequencies, 0.3 s a solve instead of 1.8 s)
+    lw = np.log(w)
+    keep = np.union1d(act, np.abs(lw[:, None] - np.linspace(lw[0], lw[-1], spread)[None, :]).argmin(axis=0))
+    Kw, Cr, Br = Kw[keep], Cr[keep], Br[keep]
     J = modal.d_response(Cr, Br) * modal.scale[None, None, :]
     Kn = np.linalg.norm(Kw.reshape(Kw.shape[0], -1), axis=1)
     J = J / np.maximum(Kn, 1e-300)[:, None, None]
@@ -1792,7 +1799,7 @@ def refine_controller(P, structure: BlockStructure, K, nmeas: int, ncon: int, *,
                 ti = time.perf_counter()
                 peak = max(p.value for p in pts)
                 Kw, Cr, Br = modal.response(theta, 1j * w)
-                res = _refine_step(modal, theta, pts, M, U, V, Kw, Cr, Br, rho)
+                res = _refine_step(modal, theta, pts, M, U, V, Kw, Cr, Br, rho, w)
                 ok = missed = False
                 model = float("nan")
                 if res is not None:
