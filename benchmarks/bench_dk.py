@@ -68,14 +68,14 @@ states, 35 s) and 1.0131 (20 states, 47 s) at 0.041 m, 1.1422 (16, 26 s) and
 1.1395 (20, 38 s) at 0.035 m, with complex bounds 0.4-0.8 % higher: those
 controllers use the parameters' realness.  Refining them (``mutext
 dgk-refine``) with ``--refine-steps 300`` gave, with the same 20 states,
-0.9895 at 0.041 m (607 s in all) and 1.1167 at 0.035 m (792 s), the refined
+0.9896 at 0.041 m (267 s in all) and 1.1165 at 0.035 m (411 s), the refined
 loops' own reports equal to these verdicts (dkpy fixed in the same run:
-1.0142, 36 states, 49 s, and its panic at 0.035 m).  Any configuration can
+1.0142, 36 states, 51 s, and its panic at 0.035 m).  Any configuration can
 be followed by the refinement (``mutext default-refine``, ``mutext
 tight-refine``, ...): on the distillation column ``--tools "mutext default"
 "mutext tight" "mutext default-refine" "dkpy auto" "dkpy fixed"`` gave
-1.0501 (1.5 s), 1.0282 (3.3 s), **0.9953** (80 steps, 458 s), 1.0492 and
-1.0786 (dkpy reports 1.0339 and 1.0360; 31 s and 30 s), with 18, 18, 18,
+1.0501 (2.5 s), 1.0282 (5.7 s), **0.9943** (80 steps, 260 s), 1.0492 and
+1.0786 (dkpy reports 1.0339 and 1.0360; 50 s and 30 s), with 18, 18, 18,
 22 and 22 states.
 
 Usage::

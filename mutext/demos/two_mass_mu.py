@@ -33,7 +33,7 @@ def add_arguments(p):
     p.add_argument("--refine", type=int, default=0, metavar="STEPS",
                    help="then refine the controller by this many steps on the D-G bound with the "
                         "scalings of every frequency (mutext.dk.refine_controller; about a second a step: "
-                        "with --real at 0.041 m, 100 steps reach mu = 0.9896 in about three minutes)")
+                        "with --real at 0.041 m, 100 steps reach mu = 0.9896 in about two minutes)")
 
 
 def check_controller(K, x_max: float, rel: float = 0.02) -> dict:
@@ -162,7 +162,7 @@ def run(args) -> int:
     if out["mu_upper_dg"] >= 1:
         print("hint: relax the bound (--xmax; with D-K, mu drops below 1 near 0.043 m here), or keep the "
               "parameters real and refine the controller (--real --refine 100 reaches mu = 0.9896 at 0.041 m, "
-              "in about three minutes)")
+              "in about two minutes)")
     for n in out["notes"]:
         print(f"note: {n}")
     print(f"time: {out['seconds']:.1f} s")
