@@ -1515,7 +1515,7 @@ def _dg_points(Ms, S, old=None, reject_at=np.inf):
     return pts
 
 
-def _refine_step(modal, theta, pts, M, U, V, Kw, Cr, Br, rho, w, band=0.01, gap=0.02, spread=120):
+def _refine_step(modal, theta, pts, M, U, V, rho, w, band=0.01, gap=0.02, spread=120):
     """Trust-region model step: minimise max over the active frequencies of the linearised
     lambda_max of Q (on its top eigenspace), with every parameter moving at most ``rho`` of
     its size and K(jw) at most ``rho`` of its norm at the active frequencies and at ``spread``
@@ -1532,6 +1532,14 @@ def _refine_step(modal, theta, pts, M, U, V, Kw, Cr, Br, rho, w, band=0.01, gap=
     idx = [i for i in _local_maxima(top, top.size) if near[i]]
     act = np.unique(np.clip(np.concatenate([np.asarray(idx, int) + k for k in (-1, 0, 1)]), 0, top.size - 1))
     act = act[near[act]]
+    # K(jw) moves smoothly between grid points: its trust region on a log-even subset of the
+    # grid (dense near the peaks) constrains the step as much, at a fraction of the cost
+    # (on the distillation column's 527 frequencies, 0.3 s a solve instead of 1.8 s); the
+    # controller's response is needed there and at the active frequencies only
+    lw = np.log(w)
+    keep = np.union1d(act, np.abs(lw[:, None] - np.linspace(lw[0], lw[-1], spread)[None, :]).argmin(axis=0))
+    Kw, Cr, Br = modal.response(theta, 1j * w[keep])
+    pos = {int(i): j for j, i in enumerate(keep)}
     nt = theta.size
     d = cp.Variable(nt)
     tau = cp.Variable()
@@ -1542,7 +1550,7 @@ def _refine_step(modal, theta, pts, M, U, V, Kw, Cr, Br, rho, w, band=0.01, gap=
         p = pts[k]
         Lft = Yk.conj().T @ p.R @ (M[k].conj().T @ p.Dl + 1j * p.G) @ U[k]
         Rgt = V[k] @ p.R @ Yk
-        F = modal.sensitivity_factors(Lft, Rgt, Cr[k], Br[k]) * modal.scale[:, None, None]
+        F = modal.sensitivity_factors(Lft, Rgt, Cr[pos[k]], Br[pos[k]]) * modal.scale[:, None, None]
         H = F + np.conj(np.swapaxes(F, 1, 2))
         m = Yk.shape[1]
         if m == 1:
@@ -1558,12 +1566,6 @@ def _refine_step(modal, theta, pts, M, U, V, Kw, Cr, Br, rho, w, band=0.01, gap=
     cons = list(lmis)
     if lin_rows:
         cons.append(np.array(lin_rhs) + np.array(lin_rows) @ d <= tau)
-    # K(jw) moves smoothly between grid points: its trust region on a log-even subset of the
-    # grid (dense near the peaks) constrains the step as much, at a fraction of the cost
-    # (on the distillation column's 527 frequencies, 0.3 s a solve instead of 1.8 s)
-    lw = np.log(w)
-    keep = np.union1d(act, np.abs(lw[:, None] - np.linspace(lw[0], lw[-1], spread)[None, :]).argmin(axis=0))
-    Kw, Cr, Br = Kw[keep], Cr[keep], Br[keep]
     J = modal.d_response(Cr, Br) * modal.scale[None, None, :]
     Kn = np.linalg.norm(Kw.reshape(Kw.shape[0], -1), axis=1)
     J = J / np.maximum(Kn, 1e-300)[:, None, None]
@@ -1798,8 +1800,7 @@ def refine_controller(P, structure: BlockStructure, K, nmeas: int, ncon: int, *,
                              f"{w.size} frequencies", 0.05 + 0.88 * min(step - 1, max_steps) / max_steps)
                 ti = time.perf_counter()
                 peak = max(p.value for p in pts)
-                Kw, Cr, Br = modal.response(theta, 1j * w)
-                res = _refine_step(modal, theta, pts, M, U, V, Kw, Cr, Br, rho, w)
+                res = _refine_step(modal, theta, pts, M, U, V, rho, w)
                 ok = missed = False
                 model = float("nan")
                 if res is not None:
