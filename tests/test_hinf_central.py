@@ -208,16 +208,18 @@ def test_construction_and_level_method_are_reported():
     assert res.gamma == pytest.approx(lmi.gamma, rel=1e-6)
 
 
-def test_nearly_singular_d21_better_than_slycot():
-    """D21 = 1e-6: slycot's gamma iteration stops at 0.86345 (its controller achieves that);
-    the central controller achieves 0.8447 (AB13DD and a dense solve), and SLICOT finds no
-    controller 0.1 % below our level.  slycot's level is 2 % above the optimum here."""
+def test_nearly_singular_d21_not_worse_than_slycot():
+    """D21 = 1e-6: the central controller achieves 0.8447 (AB13DD and a dense solve), and
+    SLICOT finds no controller 0.1 % below our level.  Where slycot's gamma iteration stops
+    depends on the machine's LAPACK on this nearly singular problem (0.8635 and 0.8495 seen,
+    2 % and 0.6 % above the optimum); it never stops below ours."""
     P = _two_mass("D21", 1e-6)
     res = hinfsyn(P, 1, 1)
     achieved = check_level_and_controller(P, 1, 1, res)
+    assert achieved == pytest.approx(0.8447, rel=1e-3)
     ref = slycot_hinfsyn(P, 1, 1, timeout=30)
     assert ref.status == "verified"
-    assert achieved < ref.achieved * (1 - 1e-2)
+    assert achieved <= ref.achieved * (1 + 1e-6)
 
 
 def test_singular_d21_regularised_central_controller():
