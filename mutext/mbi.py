@@ -424,6 +424,8 @@ class WzTry:
     controller_order: int
     seconds: float
     iterations: int
+    #: the D-G bound (``mu_upper`` is the branch-and-bound bound where that was run)
+    mu_dg: float = float("nan")
 
 
 @dataclass
@@ -647,7 +649,7 @@ def identify(true, engineering, *, excitation: str, measurement: str, control_in
              max_tries: int = 8, regularization: float | None = 1e-4, omega=None,
              dk_options: dict | None = None, out=None, time_limit: float | None = None,
              max_fit_residual: float = 0.2, progress: Callable[[str, float], None] | None = None,
-             real: bool = False) -> MBIResult:
+             real: bool = False, branch: bool = False) -> MBIResult:
     r"""Identify the unmodeled dynamics of ``engineering`` by mu-synthesis (thesis sec. 3.5).
 
     Runs D-K iteration on the plant of :func:`mbi_plant` and tunes :math:`W_z`
@@ -700,6 +702,14 @@ def identify(true, engineering, *, excitation: str, measurement: str, control_in
         (:func:`mutext.dk.dgk_iteration`) instead of plain D-K.  On trial 5
         (10 % uncertainty) it accepted :math:`W_z` = 5.67 mm against 5.89 mm,
         in 3.3 times the time; the coefficients read from K moved little.
+    branch : bool
+        Judge each try whose D-G bound could decide it (above ``1 - tol``) by
+        branch and bound on the real parameters (:func:`mutext.dk.branch_mu`),
+        a certified bound that closes the D-G bound's gap to :math:`\mu` where
+        the ranges are wide.  On trial 5 (10 % uncertainty) a D-K loop at
+        :math:`W_z` = 5 mm reads 1.047 by D-G and 0.996 by branch and bound,
+        its lower bound 0.996: the search can accept values the D-G bound
+        rejects.  Each judged try costs some seconds more.
 
     Raises
     ------
@@ -730,6 +740,8 @@ def identify(true, engineering, *, excitation: str, measurement: str, control_in
     """
     t0 = time.perf_counter()
     _check_search_arguments(max_tries, time_limit, tol, real)
+    if not isinstance(branch, (bool, np.bool_)):
+        raise ModelError(f"identify: branch must be True or False, got {branch!r}")
     say = _logger(out)
     measured, measured_fit = None, None
     if isinstance(true, FRF):
@@ -748,7 +760,7 @@ def identify(true, engineering, *, excitation: str, measurement: str, control_in
     opts = {"max_iter": 4, "out": None if out is None else out}
     opts.update(dk_options or {})
     search = _search_wz(lambda w: mbi_plant(true, engineering, Wz=w, **kw), Wz, floor, omega, opts, tol,
-                        max_tries, time_limit, t0, say, progress, real)
+                        max_tries, time_limit, t0, say, progress, real, branch)
     best = _best_try(search.tries)
     plant, res = search.runs[best]
     if search.failed:
@@ -886,9 +898,9 @@ def _try_progress(progress, k: int, max_tries: int, Wz: float):
 
 
 def _search_wz(plant_at, Wz: float, floor: WzFloor, omega, opts: dict, tol: float, max_tries: int,
-               time_limit, t0: float, say, progress, real: bool = False) -> _WzSearch:
+               time_limit, t0: float, say, progress, real: bool = False, branch: bool = False) -> _WzSearch:
     r"""D-K runs at successive :math:`W_z` until :math:`1 - \text{tol} \le \mu \le 1` (see :func:`identify`)."""
-    from .dk import dgk_iteration, dk_iteration
+    from .dk import branch_mu, dgk_iteration, dk_iteration
     s = _WzSearch()
     lo = floor.value or None    # Wz with mu > 1 (too tight; the floor is one) / mu <= 1
     hi = None
@@ -916,10 +928,17 @@ def _search_wz(plant_at, Wz: float, floor: WzFloor, omega, opts: dict, tol: floa
             Wz = float(Wz * 1.07)
             continue
         mu = float(max(res.mu_upper_dg, 0.0)) if np.isfinite(res.mu_upper_dg) else float(res.mu_upper)
+        mu_dg = mu
+        if branch and plant.structure.has_real and mu > 1.0 - tol:
+            if progress is not None:
+                progress(f"W_z try {k + 1}/{max_tries}: branch and bound on the real parameters",
+                         (k + 0.95) / max_tries)
+            mu = min(mu, branch_mu(res, plant.structure).value)
         s.tries.append(WzTry(Wz, mu, float(res.mu_lower), res.controller_order, time.perf_counter() - ti,
-                             len(res.history)))
+                             len(res.history), mu_dg))
         s.runs.append((plant, res))
-        say(f"       mu <= {mu:.4f} (lower {res.mu_lower:.4f})")
+        say(f"       mu <= {mu:.4f} (lower {res.mu_lower:.4f})"
+            + (f"; D-G bound {mu_dg:.4f}" if mu < mu_dg else ""))
         if 1.0 - tol <= mu <= 1.0:
             break
         if mu > 1.0:

@@ -218,6 +218,29 @@ def test_trial_5_within_the_uncertainty():
 
 
 @pytest.mark.slow
+def test_branch_and_bound_certifies_a_tighter_bound_on_trial_5():
+    """Trial 5 judged by branch and bound on the three real parameters: the accepted W_z is
+    one the D-G bound rejects (its mu there is above 1) and lower than the D-G search's,
+    and the controlled model follows the true rigs (vertices and samples) within it."""
+    from mutext.demos.three_mass import solve
+    plain = solve("5", out=None)
+    r = solve("5", out=None, branch=True)
+    res = r["result"]
+    best = next(t for t in res.tries if t.Wz == res.Wz)
+    assert res.mu_upper <= 1.0 and best.mu_dg > 1.0
+    assert res.mu_lower <= res.mu_upper
+    assert res.floor.value < res.Wz < plain["Wz"]
+    U = tm.true_model(tm.TRIALS["5"])
+    for d in U.sample(8, rng=3, vertices=True):
+        assert res.error(U.at(U.values(d))).max() <= 1.05 * res.Wz
+
+
+def test_identify_names_a_bad_branch_option():
+    with pytest.raises(ModelError, match="branch must be True or False"):
+        identify(**tm.mbi_arguments(tm.TRIALS["1a"]), branch="yes")
+
+
+@pytest.mark.slow
 @pytest.mark.parametrize("name", ["1b", "2", "3", "4",
                                   pytest.param("5", marks=pytest.mark.xfail(strict=True, reason=TRIAL5_GAP))])
 def test_identify_trial(name):

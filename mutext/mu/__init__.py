@@ -147,6 +147,7 @@ References
 from __future__ import annotations
 
 from ._bounds import MuBounds, mu_bounds
+from ._branch import BranchPeak, MuBranch, branch_certifies, branch_peak, mu_upper_branch
 from ._certificate import MuUpper, dg_bound, scaled_sigma
 from ._disc import DiscForm, dg_disc, disc_transform
 from ._lmi import _LMIProblem  # noqa: F401  (tests patch the LMI solver through mutext.mu)
@@ -155,6 +156,7 @@ from ._structure import Block, BlockStructure
 from ._sweep import MuSweep, default_grid, mu_sweep
 from ._upper import mu_upper
 
-__all__ = ["Block", "BlockStructure", "MuUpper", "MuLower", "MuBounds", "MuSweep",
+__all__ = ["Block", "BlockStructure", "MuUpper", "MuLower", "MuBounds", "MuSweep", "MuBranch",
+           "BranchPeak", "mu_upper_branch", "branch_certifies", "branch_peak",
            "mu_upper", "mu_lower", "mu_bounds", "mu_sweep", "default_grid", "scaled_sigma",
            "dg_bound", "DiscForm", "dg_disc", "disc_transform"]
