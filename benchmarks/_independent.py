@@ -15,18 +15,22 @@ move every verdict at once.  This module judges a controller with other code:
   (``numpy.linalg.solve`` of ``(jwI - A) X = B``), which stays accurate where
   Hessenberg-based evaluations lose digits on widely scaled loops;
 * mu is SLICOT's AB13MD upper bound (mixed real/complex D-G scalings) on a
-  dense grid, with its local peaks refined by golden-section search.
+  dense grid, with its local peaks refined by golden-section search;
+* mixed mu of one matrix with real scalars and one full complex block is
+  computed by brute force from the main loop theorem (:func:`mixed_mu_brute_force`).
 
 Each function says what it used, so that a benchmark table can print it.
 """
 from __future__ import annotations
 
+import itertools
 import math
 
 import control as ct
 import mpmath
 import numpy as np
 import scipy.linalg as sla
+from scipy.optimize import minimize
 from slycot import ab13md
 
 USED = ("loop: python-control StateSpace.lft; poles: mpmath.eig (40 digits) of the balanced A "
@@ -130,3 +134,46 @@ def hinf_norm(CL) -> float:
     out = ab13dd("C", "I", "N", "D", n, m, p, np.asarray(s.A, float), np.eye(n), np.asarray(s.B, float),
                  np.asarray(s.C, float), np.asarray(s.D, float))
     return float(out[0])
+
+
+def mixed_mu_brute_force(M, nreal: int, points: int = 41, polish: int = 1) -> float:
+    r"""Mixed mu of ``M`` with ``nreal`` real ``1 x 1`` blocks first and one full complex block
+    last, from the main loop theorem: :math:`\mu < \beta` iff for every real
+    :math:`|\delta_i| \le 1/\beta`, :math:`I - M_{11}\Delta_r` is nonsingular and
+    :math:`\bar\sigma(\mathcal F_u(M, \Delta_r)) < \beta`.  The grid of the real parameters
+    includes the box's corners and its ``polish`` best points are polished (Powell); the value
+    is a lower bound on mu, tight when the polish finds the worst parameters."""
+    m = nreal
+    M11, M12, M21, M22 = M[:m, :m], M[:m, m:], M[m:, :m], M[m:, m:]
+    grid = np.array(list(itertools.product(np.linspace(-1.0, 1.0, points), repeat=m)))
+
+    def gains(d):
+        A = np.eye(m)[None] - M11[None] * d[:, None, :]              # I - M11 diag(d)
+        if np.min(np.abs(np.linalg.det(A))) < 1e-12:
+            return np.full(d.shape[0], np.inf)
+        X = np.linalg.solve(A, np.broadcast_to(M12, (d.shape[0],) + M12.shape))
+        return np.linalg.norm(M22[None] + M21[None] @ (d[:, :, None] * X), 2, axis=(1, 2))
+
+    def worst(beta):
+        g = gains(grid / beta)
+        best = g.max()
+        if not np.isfinite(best):
+            return best
+        # polish the best grid points (the maximum may lie between grid points)
+        for k in np.argsort(-g)[:polish]:
+            r = minimize(lambda x: -min(gains(np.clip(x, -1, 1)[None] / beta)[0], 1e300), grid[k], method="Powell",
+                         bounds=[(-1, 1)] * m, options={"xtol": 1e-9, "ftol": 1e-12})
+            best = max(best, -r.fun)
+        return best
+
+    return fixed_point_level(worst, np.linalg.norm(M, 2))
+
+
+def fixed_point_level(worst, top: float) -> float:
+    """The level where ``worst(beta) = beta`` (``worst`` falls as ``beta`` grows), by bisection
+    on ``(0, top]``; mu never exceeds the largest singular value ``top``."""
+    lo, hi = 0.0, top * (1 + 1e-9)
+    while hi - lo > 1e-7 * hi:
+        mid = 0.5 * (lo + hi)
+        lo, hi = (mid, hi) if worst(mid) >= mid else (lo, mid)
+    return lo

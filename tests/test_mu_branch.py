@@ -7,59 +7,20 @@ checked here with numpy.
 """
 from __future__ import annotations
 
-import itertools
+import sys
+from pathlib import Path
 
 import numpy as np
 import pytest
-from scipy.optimize import minimize
 from slycot import ab13md
 
 from mutext.errors import ModelError
 from mutext.mu import (Block, BlockStructure, branch_certifies, mu_lower, mu_upper,
                        mu_upper_branch)
 
-
-def brute_force_mu(M, nreal: int, points: int = 81) -> float:
-    r"""Mixed mu of ``M`` with ``nreal`` real ``1 x 1`` blocks first and one full complex block
-    last, from the main loop theorem: :math:`\mu < \beta` iff for every real
-    :math:`|\delta_i| \le 1/\beta`, :math:`I - M_{11}\Delta_r` is nonsingular and
-    :math:`\bar\sigma(\mathcal F_u(M, \Delta_r)) < \beta`.  The grid of the real parameters
-    includes the box's corners and its best points are polished; the value is a lower
-    bound on mu, tight when the polish finds the worst parameters."""
-    m = nreal
-    M11, M12, M21, M22 = M[:m, :m], M[:m, m:], M[m:, :m], M[m:, m:]
-    grid = np.array(list(itertools.product(np.linspace(-1.0, 1.0, points), repeat=m)))
-
-    def gains(d):
-        A = np.eye(m)[None] - M11[None] * d[:, None, :]              # I - M11 diag(d)
-        if np.min(np.abs(np.linalg.det(A))) < 1e-12:
-            return np.full(d.shape[0], np.inf)
-        X = np.linalg.solve(A, np.broadcast_to(M12, (d.shape[0],) + M12.shape))
-        return np.linalg.norm(M22[None] + M21[None] @ (d[:, :, None] * X), 2, axis=(1, 2))
-
-    def worst(beta):
-        g = gains(grid / beta)
-        best = g.max()
-        if not np.isfinite(best):
-            return best
-        # polish the best grid point (the maximum may lie between grid points)
-        for k in np.argsort(-g)[:1]:
-            r = minimize(lambda x: -min(gains(np.clip(x, -1, 1)[None] / beta)[0], 1e300), grid[k], method="Powell",
-                         bounds=[(-1, 1)] * m, options={"xtol": 1e-9, "ftol": 1e-12})
-            best = max(best, -r.fun)
-        return best
-
-    return _fixed_point(worst, np.linalg.norm(M, 2))
-
-
-def _fixed_point(worst, top: float) -> float:
-    """The level where ``worst(beta) = beta`` (``worst`` falls as ``beta`` grows), by bisection
-    on ``(0, top]``; mu never exceeds the largest singular value ``top``."""
-    lo, hi = 0.0, top * (1 + 1e-9)
-    while hi - lo > 1e-7 * hi:
-        mid = 0.5 * (lo + hi)
-        lo, hi = (mid, hi) if worst(mid) >= mid else (lo, mid)
-    return lo
+sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "benchmarks"))
+from _independent import fixed_point_level as _fixed_point  # noqa: E402
+from _independent import mixed_mu_brute_force as brute_force_mu  # noqa: E402
 
 
 def _cases(nreal, ncomplex, count, seed):
@@ -161,7 +122,6 @@ def test_three_mass_loop_with_ten_percent_uncertainty():
     over the grid proves mu < 1 and meets the brute-force value at its frequency.  The loop is
     rebuilt with python-control and its response computed by dense solves."""
     import control as ct
-    from pathlib import Path
     from mutext.examples import three_mass as tm
     from mutext.mbi import mbi_plant
     from mutext.mu import branch_peak
