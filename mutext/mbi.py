@@ -769,6 +769,11 @@ def identify(true, engineering, *, excitation: str, measurement: str, control_in
     if measured_fit is not None:
         notes += _measured_notes(plant, res, measured, measured_fit)
     notes += _search_notes(search, best, tol, max_tries, time_limit, t0)
+    judged = [t for t in search.tries if t.mu_upper < t.mu_dg]
+    if judged:
+        notes.append(f"branch and bound on the real parameters judged {len(judged)} of {len(search.tries)} "
+                     f"tries below their D-G bound (accepted W_z: mu {search.tries[best].mu_upper:.4f}, "
+                     f"D-G {search.tries[best].mu_dg:.4f})")
     if plant.eps_u or plant.eps_y:
         notes.append(f"regularised: control penalty {plant.eps_u:.3g} per unit u, sensor noise "
                      f"{plant.eps_y:.3g} (the thesis plant is singular)")

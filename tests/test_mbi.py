@@ -228,6 +228,8 @@ def test_branch_and_bound_certifies_a_tighter_bound_on_trial_5():
     res = r["result"]
     best = next(t for t in res.tries if t.Wz == res.Wz)
     assert res.mu_upper <= 1.0 and best.mu_dg > 1.0
+    assert any(n.startswith("branch and bound on the real parameters judged") for n in res.notes)
+    assert "(D-G " not in " ".join(plain["result"].notes)
     assert res.mu_lower <= res.mu_upper
     assert res.floor.value < res.Wz < plain["Wz"]
     U = tm.true_model(tm.TRIALS["5"])

@@ -87,7 +87,7 @@ def solve(trial: str = "1a", out=sys.stderr, measured=None, progress=None, real:
         {"order": res.measured_fit.order, "residual": res.measured_fit.residual},
         "Wz_floor": res.floor.value,
         "controller_order": res.K.nstates,
-        "tries": [{"Wz": t.Wz, "mu": t.mu_upper} for t in res.tries],
+        "tries": [{"Wz": t.Wz, "mu": t.mu_upper, "mu_dg": t.mu_dg} for t in res.tries],
         "thesis": {"Wz": tr.Wz, "mu": tr.mu},
         "notes": list(res.notes),
         "seconds": time.perf_counter() - t0,
@@ -164,7 +164,8 @@ def run(args) -> int:
     if r["Wz_floor"] > 0:
         print(f"floor: no controller can certify W_z below {r['Wz_floor']:.4g} m (spread of the true rigs"
               f" at {res.floor.omega:.3g} rad/s)")
-    print("tries: " + ", ".join(f"W_z={t['Wz']:.4g} -> mu={t['mu']:.4f}" for t in r["tries"]))
+    print("tries: " + ", ".join(f"W_z={t['Wz']:.4g} -> mu={t['mu']:.4f}"
+                                + (f" (D-G {t['mu_dg']:.4f})" if t["mu_dg"] > t["mu"] else "") for t in r["tries"]))
     print(f"controller order {r['controller_order']}; identifiable band "
           f"{r['band_rad_s'][0]:.3g}-{r['band_rad_s'][1]:.3g} rad/s")
     print(f"reading of K: {res.fit.description}")
