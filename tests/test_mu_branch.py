@@ -97,6 +97,9 @@ def test_without_real_blocks_the_dg_bound_is_returned():
     M = np.random.default_rng(0).standard_normal((3, 3)) + 0j
     b = mu_upper_branch(M, S)
     assert b.value == b.dg == pytest.approx(mu_upper(M, S, method="fast").value) and b.boxes == 0
+    # one box, nothing to cut: a level is proved exactly when the D bound is below it
+    assert branch_certifies(M, S, 1.001 * b.dg) == (True, 1)
+    assert branch_certifies(M, S, 0.999 * b.dg) == (False, 1)
 
 
 @pytest.mark.parametrize("kw, text", [({"rtol": 0.0}, "rtol"), ({"rtol": 2}, "rtol"),
@@ -108,7 +111,12 @@ def test_bad_options_are_named(kw, text):
 
 
 def test_bad_level_and_size_are_named():
+    from mutext.mu import branch_peak
     S = BlockStructure([Block.real(1), Block.full(1)])
+    with pytest.raises(ModelError, match="one matrix per point"):
+        branch_peak(np.eye(2), S)
+    with pytest.raises(ModelError, match="upper has 3 values for 2 matrices"):
+        branch_peak(np.stack([np.eye(2), np.eye(2)]), S, upper=[1, 2, 3])
     with pytest.raises(ModelError, match="level"):
         branch_certifies(np.eye(2), S, -1.0)
     with pytest.raises(ModelError, match="needs 2x2"):

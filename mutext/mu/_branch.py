@@ -120,7 +120,7 @@ def branch_certifies(M, structure, level: float, *, max_boxes: int = 2000) -> tu
     n_out, n_in = N.shape                    # M maps the nrows inputs w to the ncols outputs z
     eye = np.eye(n_out)
     # boxes of the normalised parameters, worst bound first: (-bound, tie, centres, radii)
-    params = _DGParams(S, True)
+    params = _DGParams(S, S.has_real)
     heap = [(-np.inf, 0, np.zeros(len(real)), np.ones(len(real)), None)]
     used, tie = 0, 1
     while heap:
@@ -145,6 +145,8 @@ def branch_certifies(M, structure, level: float, *, max_boxes: int = 2000) -> tu
         # most 1 that makes I - W Delta_c singular refutes the level
         if Sc is not None and _complex_lower(W[np.ix_(out_c, in_c)], Sc) >= 1.0:
             return False, used
+        if not real:
+            return False, used                # nothing to cut: the D-G bound is all there is
         j = int(np.argmax(r))
         for side in (-0.5, 0.5):
             c2, r2 = c.copy(), r.copy()
