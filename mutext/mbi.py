@@ -707,8 +707,8 @@ def identify(true, engineering, *, excitation: str, measurement: str, control_in
         branch and bound on the real parameters (:func:`mutext.dk.branch_mu`),
         a certified bound that closes the D-G bound's gap to :math:`\mu` where
         the ranges are wide.  On trial 5 (10 % uncertainty) a D-K loop at
-        :math:`W_z` = 5 mm reads 1.047 by D-G and 0.996 by branch and bound,
-        its lower bound 0.996: the search can accept values the D-G bound
+        :math:`W_z` = 5 mm reads 1.047 by D-G and 0.998 by branch and bound,
+        its lower bound 0.998: the search can accept values the D-G bound
         rejects.  Each judged try costs some seconds more.
 
     Raises
