@@ -41,6 +41,7 @@ import numpy as np
 
 from ..errors import ModelError
 from ._fast import _DGParams, _fast_at, _fast_polish
+from ._lower import mu_lower
 from ._structure import BlockStructure, _as_structure
 from ._upper import mu_upper
 
@@ -83,7 +84,6 @@ def _complex_lower(W, Sc: BlockStructure) -> float:
     """A lower bound on the complex mu of ``W`` (exact for one full block)."""
     if len(Sc.blocks) == 1 and Sc.blocks[0].kind == "full":
         return float(np.linalg.norm(W, 2))
-    from ._lower import mu_lower
     return mu_lower(W, Sc).value
 
 
@@ -205,7 +205,6 @@ def mu_upper_branch(M, structure, *, lower: float | None = None, rtol: float = 1
                              f"got {v!r}")
     dg = mu_upper(M, S, method="fast").value
     if lower is None:
-        from ._lower import mu_lower
         lower = mu_lower(M, S).value
     lower = float(min(max(lower, 0.0), dg))
     if not _real_blocks(S) or dg <= max(lower, 0.0) * (1 + rtol) or dg == 0.0:
