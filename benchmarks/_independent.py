@@ -136,18 +136,23 @@ def hinf_norm(CL) -> float:
     return float(out[0])
 
 
-def mixed_mu_brute_force(M, nreal: int, points: int = 41, polish: int = 1) -> float:
-    r"""Mixed mu of ``M`` with ``nreal`` real ``1 x 1`` blocks first and one full complex block
-    last, from the main loop theorem: :math:`\mu < \beta` iff for every real
+def mixed_mu_brute_force(M, nreal: int, points: int = 41, polish: int = 1, sizes=None) -> float:
+    r"""Mixed mu of ``M`` with ``nreal`` real scalar blocks first (block ``i`` is
+    :math:`\delta_i I_{s_i}`, ``sizes`` the :math:`s_i`, all 1 by default) and one full complex
+    block last (any shape), from the main loop theorem: :math:`\mu < \beta` iff for every real
     :math:`|\delta_i| \le 1/\beta`, :math:`I - M_{11}\Delta_r` is nonsingular and
     :math:`\bar\sigma(\mathcal F_u(M, \Delta_r)) < \beta`.  The grid of the real parameters
     includes the box's corners and its ``polish`` best points are polished (Powell); the value
     is a lower bound on mu, tight when the polish finds the worst parameters."""
-    m = nreal
+    sizes = np.ones(nreal, int) if sizes is None else np.asarray(sizes, int)
+    if sizes.shape != (nreal,) or np.any(sizes < 1):
+        raise ValueError(f"sizes must hold {nreal} positive block sizes, got {sizes!r}")
+    m = int(sizes.sum())
     M11, M12, M21, M22 = M[:m, :m], M[:m, m:], M[m:, :m], M[m:, m:]
-    grid = np.array(list(itertools.product(np.linspace(-1.0, 1.0, points), repeat=m)))
+    grid = np.array(list(itertools.product(np.linspace(-1.0, 1.0, points), repeat=nreal)))
 
     def gains(d):
+        d = np.repeat(d, sizes, axis=1)                               # the diagonal of Delta_r
         A = np.eye(m)[None] - M11[None] * d[:, None, :]              # I - M11 diag(d)
         if np.min(np.abs(np.linalg.det(A))) < 1e-12:
             return np.full(d.shape[0], np.inf)
@@ -162,7 +167,7 @@ def mixed_mu_brute_force(M, nreal: int, points: int = 41, polish: int = 1) -> fl
         # polish the best grid points (the maximum may lie between grid points)
         for k in np.argsort(-g)[:polish]:
             r = minimize(lambda x: -min(gains(np.clip(x, -1, 1)[None] / beta)[0], 1e300), grid[k], method="Powell",
-                         bounds=[(-1, 1)] * m, options={"xtol": 1e-9, "ftol": 1e-12})
+                         bounds=[(-1, 1)] * nreal, options={"xtol": 1e-9, "ftol": 1e-12})
             best = max(best, -r.fun)
         return best
 
