@@ -21,15 +21,19 @@ References
 """
 from __future__ import annotations
 
+from importlib import resources
+
 import control as ct
 import numpy as np
 
+from ..errors import ModelError
 from ..lti import ss
 from ..mu import Block, BlockStructure
 from ..uncertain import UncertainModel, UncertainParameter, uncertain_mck
 from .two_mass import TwoMass
 
-__all__ = ["THESIS_MU", "parameters", "uncertain_model", "plant", "structure", "plant_at"]
+__all__ = ["THESIS_MU", "parameters", "uncertain_model", "plant", "structure", "plant_at",
+           "refined_controller"]
 
 #: mu values reported in the thesis (sec. 2.3.2) for x_max = 0.035 m and 0.041 m.
 THESIS_MU = {0.035: 1.11, 0.041: 0.9890}
@@ -101,3 +105,47 @@ def plant_at(delta, x_max: float = 0.035, rel: float = 0.02, p: TwoMass | None =
     U = uncertain_model(p, rel)
     G = U.at(U.values(delta))
     return _weighting(G, 0, p)
+
+
+#: steps of :func:`mutext.dk.refine_controller` behind each stored controller
+REFINED_STEPS = {0.041: 1500, 0.035: 700}
+
+
+def refined_controller(x_max: float = 0.041) -> ct.StateSpace:
+    r"""The 20-state controller of the book's longest refinement at ``x_max`` (0.041 or 0.035 m).
+
+    Made by :func:`mutext.dk.dgk_iteration` with the two-mass demo's budget
+    (``max_states = P.nstates + 16``) and then :func:`mutext.dk.refine_controller`
+    run for 1,500 steps at 0.041 m and 700 at 0.035 m (about half an hour and ten
+    minutes), stored so that its bounds can be checked without the wait.  Its loop
+    ``lft(plant(x_max), K)`` is stable and its mixed :math:`\mu` (four real
+    parameters, complex performance block) is
+
+    ======  =================  ===========  ================
+    x_max   D-G upper bound    lower bound  thesis (MATLAB)
+    ======  =================  ===========  ================
+    0.041   0.98931            0.98886      0.989
+    0.035   1.11644            1.11614      1.11
+    ======  =================  ===========  ================
+
+    (the test suite checks the upper bounds with SLICOT AB13MD on a loop closed by
+    python-control).  The bound is flat from DC to about 1 rad/s: there it is set by
+    the static gain :math:`K(0)` alone.
+
+    Examples
+    --------
+    >>> from mutext.examples import two_mass_uncertain as tmu
+    >>> from mutext.lti import lft_lower
+    >>> K = tmu.refined_controller(0.041)
+    >>> CL = lft_lower(tmu.plant(0.041), K, 1, 1)
+    >>> K.nstates, bool(np.linalg.eigvals(CL.A).real.max() < 0)
+    (20, True)
+    """
+    key = {round(x, 6): x for x in REFINED_STEPS}.get(round(float(x_max), 6))
+    if key is None:
+        raise ModelError(f"a refined controller is stored for x_max in {sorted(REFINED_STEPS)} m, "
+                         f"not {x_max!r}")
+    with resources.files("mutext").joinpath("data", "two_mass_refined.npz").open("rb") as fh:
+        z = np.load(fh)
+        tag = f"{key:.3f}"
+        return ss(*(np.asarray(z[f"{m}_{tag}"], float) for m in "ABCD"))
