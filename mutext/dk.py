@@ -1694,7 +1694,10 @@ def refine_controller(P, structure: BlockStructure, K, nmeas: int, ncon: int, *,
     halfway between its four largest local maxima and their neighbours (a
     probe above the old peak rejects the step and joins the grid), every
     ``regrid_every`` accepted steps the grid is refined around the ten largest
-    local maxima, and when the fine grid of the final analysis finds a peak
+    local maxima (no new point closer than 0.001 % to one of the grid, and a
+    new point starts from the scalings of its nearest neighbour, which bound
+    it from above, so that only the points that could be the largest need
+    scalings of their own), and when the fine grid of the final analysis finds a peak
     the refinement grid missed (by more than 0.01 %), its frequencies join the
     grid and the descent goes on for ``regrid_every`` more steps (at most three
     times).
@@ -1807,6 +1810,18 @@ def refine_controller(P, structure: BlockStructure, K, nmeas: int, ncon: int, *,
     def usable(w):
         return w[np.min(np.abs(w[:, None] - light[None, :]), axis=1) > 1e-3 * w] if light.size else w
 
+    def new_points(wn, w):
+        """The frequencies ``wn`` not within 0.001 % of a grid point: on a flat stretch of the
+        bound, every point is a local maximum by a few digits, and probes between ever closer
+        points would grow the grid (and the cost of a step) without finding anything."""
+        wn = usable(np.setdiff1d(np.unique(wn), w))
+        if not wn.size or w.size < 2:
+            return wn
+        lw = np.log(w)
+        i = np.clip(np.searchsorted(lw, np.log(wn)), 1, lw.size - 1)
+        gap = np.minimum(np.abs(np.log(wn) - lw[i - 1]), np.abs(np.log(wn) - lw[i]))
+        return wn[gap > 1e-5]
+
     def evaluate(theta, w):
         Kt = modal.ss(theta)
         CLa = _augmented_loop(P, Kt, nc, nr, nmeas, ncon)
@@ -1815,16 +1830,24 @@ def refine_controller(P, structure: BlockStructure, K, nmeas: int, ncon: int, *,
         F = np.moveaxis(freqresp(CLa, w), -1, 0)
         return stable, F[:, :nc, :nr], F[:, :nc, nr:], F[:, nc:, :nr]
 
-    def at(th, wp):
-        """(M, U, V, scalings) of the loop with parameters ``th`` at the frequencies ``wp``."""
+    def at(th, wp, near=None):
+        """(M, U, V, scalings) of the loop with parameters ``th`` at the frequencies ``wp``.
+        With ``near`` (a grid and its scalings), each frequency starts from the scalings of
+        the nearest grid point, whose values bound it from above, and only those that could
+        be the largest get their own (as in :func:`_dg_points`): a probe then costs one
+        eigenvalue problem instead of a descent, and no value exceeds the largest exact one."""
         _, Mp, Up, Vp = evaluate(th, wp)
-        return Mp, Up, Vp, _dg_points(Mp, S)
+        if near is None or not wp.size:
+            return Mp, Up, Vp, _dg_points(Mp, S)
+        wg, pg = near
+        j = np.abs(np.log(wp)[:, None] - np.log(wg)[None, :]).argmin(axis=1)
+        return Mp, Up, Vp, _dg_points(Mp, S, [pg[k] for k in j])
 
     def probes(w, pts):
         """Frequencies halfway (in log) between the largest local maxima and their neighbours."""
         idx = _local_maxima([p.value for p in pts], 4)
         wp = [np.sqrt(w[i] * w[j]) for i in idx for j in (i - 1, i + 1) if 0 <= j < w.size]
-        return usable(np.setdiff1d(np.unique(wp), w)) if wp else np.zeros(0)
+        return new_points(np.asarray(wp), w) if wp else np.zeros(0)
 
     def merge(w, data, wp, extra):
         """The grid and its data with the frequencies ``wp`` and their data added, in order."""
@@ -1880,10 +1903,10 @@ def refine_controller(P, structure: BlockStructure, K, nmeas: int, ncon: int, *,
                                 # a step may push a narrow peak up between grid points: probe
                                 # between the largest local maxima and their neighbours
                                 wp = probes(w, new)
-                                probed = at(cand, wp) if wp.size else None
+                                probed = at(cand, wp, (w, new)) if wp.size else None
                                 if probed and max(p.value for p in probed[3]) >= peak * (1.0 - 1e-9):
                                     # rejected, and the grid keeps the probes (with this loop's data)
-                                    w, M, U, V, pts = merge(w, (M, U, V, pts), wp, at(theta, wp))
+                                    w, M, U, V, pts = merge(w, (M, U, V, pts), wp, at(theta, wp, (w, pts)))
                                     missed = True
                                 else:
                                     ok = True
@@ -1909,9 +1932,9 @@ def refine_controller(P, structure: BlockStructure, K, nmeas: int, ncon: int, *,
                             f"{'accepted' if ok else 'rejected':>8} {w.size:>5} {time.perf_counter() - ti:>8.2f}")
                 if ok and accepted % regrid_every == 0:
                     extra = _around_peaks(w, np.array([p.value for p in pts]), 10, 6)
-                    wn = usable(np.setdiff1d(np.concatenate(extra), w)) if extra else np.zeros(0)
+                    wn = new_points(np.concatenate(extra), w) if extra else np.zeros(0)
                     if wn.size:
-                        w, M, U, V, pts = merge(w, (M, U, V, pts), wn, at(theta, wn))
+                        w, M, U, V, pts = merge(w, (M, U, V, pts), wn, at(theta, wn, (w, pts)))
                 if rho < 1e-7:
                     notes.append(f"refine: stopped at step {step}, no model step lowers the bound "
                                  f"(trust region {rho:.1e})")
