@@ -108,7 +108,7 @@ def plant_at(delta, x_max: float = 0.035, rel: float = 0.02, p: TwoMass | None =
 
 
 #: steps of :func:`mutext.dk.refine_controller` behind each stored controller
-REFINED_STEPS = {0.041: 1500, 0.035: 700}
+REFINED_STEPS = {0.041: 9075, 0.035: 8290}
 
 
 def refined_controller(x_max: float = 0.041) -> ct.StateSpace:
@@ -116,24 +116,27 @@ def refined_controller(x_max: float = 0.041) -> ct.StateSpace:
 
     Made by :func:`mutext.dk.dgk_iteration` with the two-mass demo's budget
     (``max_states = P.nstates + 16``) and then :func:`mutext.dk.refine_controller`
-    run for 1,500 steps at 0.041 m and 700 at 0.035 m (about half an hour and ten
-    minutes), stored so that its bounds can be checked without the wait.  Its loop
+    with a time limit of 40 minutes (8,775 steps at 0.041 m, then 300 more, which
+    lowered a narrow peak the last grid had missed; 8,290 steps at 0.035 m), stored
+    so that its bounds can be checked without the wait.  Its loop
     ``lft(plant(x_max), K)`` is stable and its mixed :math:`\mu` (four real
     parameters, complex performance block) is
 
-    ======  =================  ===========  ================
-    x_max   D-G upper bound    lower bound  thesis (MATLAB)
-    ======  =================  ===========  ================
-    0.041   0.98931            0.98886      0.989
-    0.035   1.11644            1.11614      1.11
-    ======  =================  ===========  ================
+    ======  =======================  ============  ===============
+    x_max   D-G bound, final grid    lower bound   thesis (MATLAB)
+    ======  =======================  ============  ===============
+    0.041   0.97812                  0.97812       0.989
+    0.035   1.11442                  1.11405       1.11
+    ======  =======================  ============  ===============
 
-    (the lower bounds are the package's, :func:`mutext.mu.mu_lower`).  The test suite
-    checks the upper bounds with SLICOT AB13MD on a loop closed by python-control, and
-    at AB13MD's peak a brute-force search over the four parameters finds perturbations
-    at 0.98931 and 1.11644: these loops' :math:`\mu` is their upper bound.  The bound is
-    flat from DC to about 1 rad/s, where the static gain :math:`K(0)` alone sets it,
-    and touches the same level in narrow peaks up to 600 rad/s (the book's mu chapter).
+    (both columns the package's).  The test suite checks them without mutext: on a
+    loop closed by python-control, SLICOT AB13MD's bound with its maxima refined by
+    golden section peaks at 0.97814 (28.4 rad/s) and 1.11442, and there a brute-force
+    search over the four parameters finds perturbations that meet it, so these are the
+    loops' :math:`\mu`.  At 0.041 m that is 1.1 % below the thesis's value.  The
+    bound is flat from DC to about 1 rad/s, where the static gain :math:`K(0)` alone
+    sets it, and touches the same level in narrow peaks up to 400 rad/s (the book's
+    mu chapter).
 
     Examples
     --------
