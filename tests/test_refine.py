@@ -316,3 +316,5 @@ def test_stored_refined_controllers_have_the_bounds_their_documentation_states(x
 def test_a_refined_controller_not_stored_is_named():
     with pytest.raises(ModelError, match=r"stored for x_max in \[0.035, 0.041\] m, not 0.05"):
         tmu.refined_controller(0.05)
+    with pytest.raises(ModelError, match=r"stored for x_max in \[0.035, 0.041\] m, not 'x'"):
+        tmu.refined_controller("x")

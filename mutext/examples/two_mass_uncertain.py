@@ -148,7 +148,10 @@ def refined_controller(x_max: float = 0.041) -> ct.StateSpace:
     >>> K.nstates, bool(np.linalg.eigvals(CL.A).real.max() < 0)
     (20, True)
     """
-    key = {round(x, 6): x for x in REFINED_STEPS}.get(round(float(x_max), 6))
+    try:
+        key = {round(x, 6): x for x in REFINED_STEPS}.get(round(float(x_max), 6))
+    except (TypeError, ValueError):
+        key = None
     if key is None:
         raise ModelError(f"a refined controller is stored for x_max in {sorted(REFINED_STEPS)} m, "
                          f"not {x_max!r}")
