@@ -385,3 +385,23 @@ def test_dk_distillation_beats_dkpy():
     ref = _ab13md_peak(CL, np.union1d(np.logspace(-8, 3, 400), [res.peak_frequency]))
     assert ref < 1.035 and res.K.nstates <= 22
     assert res.mu_upper == pytest.approx(ref, rel=2e-3)
+
+
+def test_with_real_blocks_the_iteration_kept_has_the_lowest_d_g_bound():
+    """Three-mass trial 5 (three real parameters at 10 %) at W_z = 4.86 mm: the D step after the
+    H-infinity design lowers the complex bound but raises the D-G bound that judges the loop
+    (its fitted D scalings treat the parameters as complex). The loop kept is the first, and
+    SLICOT AB13MD (real blocks real) confirms its bound below 1, where the complex one is 1.18."""
+    from mutext.examples import three_mass as tm
+    from mutext.mbi import mbi_plant
+    args = tm.mbi_arguments(tm.TRIALS["5"])
+    pl = mbi_plant(args.pop("true"), args.pop("engineering"), Wz=4.858e-3, **args)
+    res = dk_iteration(pl.P, pl.structure, 1, 1, max_iter=2, synthesis="lmi-first")
+    dg = [h["mu_dg"] for h in res.history]
+    cx = [h["mu"] for h in res.history]
+    assert len(dg) == 2 and cx[1] < cx[0] and dg[1] > dg[0]        # the situation tested
+    assert res.best_iteration == 1
+    w = np.union1d(np.logspace(-0.3, 1.7, 200), res.sweep.omega)
+    ab = ab13md_sweep(res.CL, w, ["real", "real", "real", "full2"])
+    assert ab.max() <= res.mu_upper_dg * (1 + 2e-3) and ab.max() < 1.0 < dg[1]
+    assert res.mu_upper > 1.1                                       # the complex bound of the loop kept

@@ -210,3 +210,54 @@ def test_magnitude_fit_of_non_minimum_phase_system_is_its_minimum_phase_factor()
     np.testing.assert_allclose(np.abs(ct.frequency_response(fit.sys, w).magnitude).ravel(), mag, rtol=1e-6)
     np.testing.assert_allclose(np.abs(ct.frequency_response(fit.inverse(), w).magnitude).ravel(), 1 / mag,
                                rtol=1e-6)
+
+
+# --- upper envelopes (mutext.frfit.fit_envelope, the spread-shaped weights of mutext.mbi) ---------
+
+def _three_mode_spread():
+    """Half the widest gap between the responses of a three-mass rig with m3, c3, k3 each
+    at +-10 %, at cart 1: three resonances of different height, and a fall to almost zero
+    beyond the last one (computed from the M, C, K matrices, not through an LFT)."""
+    import itertools
+    w = np.logspace(np.log10(0.4), np.log10(300.0), 400)
+    t = tm.TRIALS["5"].true
+    X = []
+    for a, b, c in itertools.product((0.9, 1.0, 1.1), repeat=3):
+        M, C, K = tm.matrices(t.with_(m3=t.m3 * a, c3=t.c3 * b, k3=t.k3 * c))
+        X.append([np.linalg.solve(K - x * x * M + 1j * x * C, [1.0, 0, 0])[0] for x in w])
+    X = np.array(X)
+    return w, np.array([np.abs(X - X[i]).max(axis=0) for i in range(len(X))]).max(axis=0) / 2
+
+
+def test_envelope_covers_a_spread_with_three_resonances():
+    import control as ct
+    w, half = _three_mode_spread()
+    fit = frfit.fit_envelope(w, half, floor=0.02)
+    W_ = np.abs(ct.frequency_response(fit.sys, w).magnitude).ravel()       # realisation, by python-control
+    env = np.maximum(half, 0.02 * half.max())
+    assert np.all(W_ >= half * (1 - 1e-9))                                  # a cover: nothing undershot
+    np.testing.assert_allclose(W_, np.abs(fit(w)), rtol=1e-8)
+    # tight where it matters: at the widest spread within 5 %, and at low frequency within 25 %
+    k = int(np.argmax(half))
+    assert W_[k] < 1.05 * half[k]
+    assert np.all(W_[w < 2.0] < 1.25 * half[w < 2.0])
+    assert fit.error == pytest.approx(np.log(W_ / env).max(), rel=1e-6)
+    # stable, minimum phase, biproper: a weight whose inverse can enter a plant
+    assert np.all(ct.poles(fit.sys).real < 0) and np.all(ct.zeros(fit.sys).real < 0)
+    assert np.all(ct.poles(fit.inverse()).real < 0) and fit.sys.D[0, 0] > 0
+
+
+def test_envelope_bad_input_is_named():
+    w = np.logspace(0, 1, 10)
+    with pytest.raises(ModelError, match="equal length"):
+        frfit.fit_envelope(w, np.ones(9))
+    with pytest.raises(ModelError, match="not all zero"):
+        frfit.fit_envelope(w, np.zeros(10))
+    with pytest.raises(ModelError, match="not all zero"):
+        frfit.fit_envelope(w, -np.ones(10))
+    with pytest.raises(ModelError, match="need floor > 0"):
+        frfit.fit_envelope(w, np.r_[0.0, np.ones(9)], floor=0.0)
+    with pytest.raises(ModelError, match=r"floor must lie in \[0, 1\)"):
+        frfit.fit_envelope(w, np.ones(10), floor=1.5)
+    with pytest.raises(ModelError, match="frequencies must be positive"):
+        frfit.fit_envelope(-w, np.ones(10))
