@@ -987,7 +987,9 @@ def fit_envelope(omega, mag, *, floor: float = 0.02, max_sections: int = 6) -> M
         falls to zero, as a spread does beyond the last resonance, would ask
         for an infinite slope).  In [0, 1).
     max_sections : int
-        Largest number of peaking sections (the most prominent peaks get them).
+        Largest number of peaking sections: one for each of the most prominent
+        peaks, and those left over a second one for the highest peaks (a
+        spread's peak is often flat-topped, which one section cannot follow).
 
     Returns
     -------
@@ -1039,7 +1041,6 @@ def fit_envelope(omega, mag, *, floor: float = 0.02, max_sections: int = 6) -> M
     # the peaks that stand out from their surroundings by at least 20 %
     idx, props = find_peaks(target, prominence=np.log(1.2))
     keep = np.argsort(props["prominences"])[::-1][:int(max_sections)] if idx.size else []
-    # (the sections left over after one per peak double the highest peaks)
     idx = np.sort(idx[keep]) if idx.size else idx
     s = 1j * omega
     base = float(np.exp(np.median(target)))
@@ -1090,6 +1091,7 @@ def fit_envelope(omega, mag, *, floor: float = 0.02, max_sections: int = 6) -> M
     lower = [-np.inf, span[0], span[0]] + [span[0], np.log(1e-3), np.log(1e-3)] * nsec
     upper = [np.inf, span[1], span[1]] + [span[1], np.log(1e6), np.log(10.0)] * nsec
     p0 = np.clip(p0, np.array(lower) + 1e-9, np.array(upper) - 1e-9)
+
     def cost(p):
         return float(np.sum(residuals(np.clip(p, lower, upper)) ** 2))
 

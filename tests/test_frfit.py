@@ -261,3 +261,6 @@ def test_envelope_bad_input_is_named():
         frfit.fit_envelope(w, np.ones(10), floor=1.5)
     with pytest.raises(ModelError, match="frequencies must be positive"):
         frfit.fit_envelope(-w, np.ones(10))
+    for bad in (-1, True, 2.5):
+        with pytest.raises(ModelError, match="max_sections must be a non-negative integer"):
+            frfit.fit_envelope(w, np.ones(10), max_sections=bad)
