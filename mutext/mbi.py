@@ -600,16 +600,16 @@ def true_spread(true, *, excitation: str, measurement: str, omega=None, rng=0):
     if not isinstance(true, UncertainModel):
         raise ModelError("the spread of the true systems needs an uncertain true model "
                          f"(mutext.uncertain.UncertainModel), got {type(true).__name__}")
-    omega = _floor_grid(true, omega)
+    omega = _floor_grid(true, omega, "true_spread")
     return omega, _true_spread(true, excitation, measurement, omega, rng)[0]
 
 
-def _floor_grid(true, omega):
+def _floor_grid(true, omega, who: str):
     if omega is None:
         omega = frequency_grid(n=400, poles=np.linalg.eigvals(np.asarray(true.nominal().A, float)))
     omega = np.asarray(omega, float)
     if omega.size == 0:
-        raise ModelError("wz_floor: the frequency grid is empty")
+        raise ModelError(f"{who}: the frequency grid is empty")
     return omega
 
 
@@ -652,7 +652,7 @@ def wz_floor(true, *, excitation: str, measurement: str, Ww: float = 1.0, omega=
     from .uncertain import UncertainModel
     if not isinstance(true, UncertainModel):
         return WzFloor(0.0, float("nan"), (), 1)
-    omega = _floor_grid(true, omega)
+    omega = _floor_grid(true, omega, "wz_floor")
 
     def spread(w):
         half, pair, deltas = _true_spread(true, excitation, measurement, w, rng)
@@ -718,7 +718,7 @@ def spread_weight(true, *, excitation: str, measurement: str, omega=None, floor:
     if not isinstance(true, UncertainModel):
         raise ModelError("a weight shaped by the spread of the true systems needs an uncertain true model "
                          f"(mutext.uncertain.UncertainModel), got {type(true).__name__}")
-    omega = _floor_grid(true, omega)
+    omega = _floor_grid(true, omega, "spread_weight")
     half, _, _ = _true_spread(true, excitation, measurement, omega, rng)
     if not half.max() > 0:
         raise ModelError("the true systems do not spread on this grid: no shape to follow")

@@ -278,6 +278,8 @@ def test_spread_weight_covers_the_spread_and_sets_the_shaped_floor():
     assert flat.value == pytest.approx(half.max(), rel=1e-3)
     with pytest.raises(ModelError, match="needs an uncertain true model"):
         spread_weight(tm.mechanical_model(tm.TRIALS["5"].true), excitation="f1", measurement="x1")
+    with pytest.raises(ModelError, match="spread_weight: the frequency grid is empty"):
+        spread_weight(args["true"], excitation="f1", measurement="x1", omega=[])
 
 
 def test_shaped_plant_divides_the_error_by_the_shape():
