@@ -1141,8 +1141,8 @@ def _dk(P, S, nmeas, ncon, grid, max_iter, max_order, budget, fit_tol, rel_impro
         # the loop kept is the one with the lowest bound that will be reported: with real blocks,
         # the D-G bound (a D step that lowers the complex bound can raise it: the fitted D scalings
         # treat the real parameters as complex)
-        if best is None or mu_dg_pk < best[5]:
-            best = (mu_pk, K, CL, list(fits), it, mu_dg_pk)
+        if best is None or mu_dg_pk < best[0]:
+            best = (mu_dg_pk, K, CL, list(fits), it)
         stall = 0 if progress else stall + 1
         # a single block has no scaling to fit: the first K step is the answer
         stop = stall >= patience or it == max_iter or len(S) == 1
@@ -1161,7 +1161,7 @@ def _dk(P, S, nmeas, ncon, grid, max_iter, max_order, budget, fit_tol, rel_impro
                     f"{PD.nstates:>6} {row['seconds']:>8.2f}")
         if stop:
             break
-    mu_pk, K, CL, used_fits, best_it, _ = best
+    _, K, CL, used_fits, best_it = best
     if as_given is not None:
         P = as_given
         CL = lft_lower(P, K, nmeas, ncon)

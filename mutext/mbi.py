@@ -561,23 +561,32 @@ def _delta_samples(m: int, rng=0) -> np.ndarray:
     return np.vstack([np.zeros((1, m)), verts, r.uniform(-1.0, 1.0, size=(64, m))])
 
 
-def _true_spread(true, excitation, measurement, omega, rng=0):
-    """Half the widest gap between sampled true systems at each frequency, and the pair that makes it:
-    ``(half (nw,), pair (2, nw) indices into deltas, deltas)``."""
+def _true_systems(true, excitation, measurement, who: str, rng=0):
+    """The true systems on a grid of the uncertainty box, closed once: ``(systems, deltas, i, o)``."""
+    from .uncertain import UncertainModel
+    if not isinstance(true, UncertainModel):
+        raise ModelError(f"{who}: the spread of the true systems needs an uncertain true model "
+                         f"(mutext.uncertain.UncertainModel), got {type(true).__name__}")
     nom = true.nominal()
     i = _index(nom, excitation, "input", "true system")
     o = _index(nom, measurement, "output", "true system")
     deltas = _delta_samples(len(true.params), rng)
-    R = np.array([freqresp(true.close(d), omega)[o, i] for d in deltas])      # (samples, nw)
+    return [true.close(d) for d in deltas], deltas, i, o
+
+
+def _half_gaps(systems, i, o, omega):
+    """Half the widest gap between the systems' responses at each frequency, and the pair
+    that makes it: ``(half (nw,), pair (2, nw) indices into systems)``."""
+    R = np.array([freqresp(S, omega)[o, i] for S in systems])      # (samples, nw)
     # widest pair per frequency, one sample against all at a time (memory: samples x nw)
     best, pair = np.zeros(omega.size), np.zeros((2, omega.size), dtype=int)
-    for a in range(len(deltas)):
+    for a in range(len(systems)):
         d = np.abs(R - R[a])
         b = np.argmax(d, axis=0)
         da = d[b, np.arange(omega.size)]
         better = da > best
         best[better], pair[0, better], pair[1, better] = da[better], a, b[better]
-    return best / 2, pair, deltas
+    return best / 2, pair
 
 
 def true_spread(true, *, excitation: str, measurement: str, omega=None, rng=0):
@@ -596,12 +605,13 @@ def true_spread(true, *, excitation: str, measurement: str, omega=None, rng=0):
     (omega, r) : tuple of numpy.ndarray
         The grid (rad/s; default as :func:`wz_floor`) and :math:`r` on it (output unit per input unit).
     """
-    from .uncertain import UncertainModel
-    if not isinstance(true, UncertainModel):
-        raise ModelError("the spread of the true systems needs an uncertain true model "
-                         f"(mutext.uncertain.UncertainModel), got {type(true).__name__}")
-    omega = _floor_grid(true, omega, "true_spread")
-    return omega, _true_spread(true, excitation, measurement, omega, rng)[0]
+    return _true_spread(true, excitation, measurement, omega, rng, "true_spread")
+
+
+def _true_spread(true, excitation, measurement, omega, rng, who):
+    systems, _, i, o = _true_systems(true, excitation, measurement, who, rng)
+    omega = _floor_grid(true, omega, who)
+    return omega, _half_gaps(systems, i, o, omega)[0]
 
 
 def _floor_grid(true, omega, who: str):
@@ -653,20 +663,21 @@ def wz_floor(true, *, excitation: str, measurement: str, Ww: float = 1.0, omega=
     if not isinstance(true, UncertainModel):
         return WzFloor(0.0, float("nan"), (), 1)
     omega = _floor_grid(true, omega, "wz_floor")
+    systems, deltas, i, o = _true_systems(true, excitation, measurement, "wz_floor", rng)
 
     def spread(w):
-        half, pair, deltas = _true_spread(true, excitation, measurement, w, rng)
+        half, pair = _half_gaps(systems, i, o, w)
         if shape is not None:
             half = half / np.abs(shape(w))
         k = int(np.argmax(half))
-        return half[k], w[k], (deltas[pair[0, k]], deltas[pair[1, k]]), len(deltas)
+        return half[k], w[k], (deltas[pair[0, k]], deltas[pair[1, k]])
 
-    half, wk, pair, n = spread(omega)
+    half, wk, pair = spread(omega)
     for _ in range(2):       # lightly damped resonances: zoom in around the widest spread
-        h2, w2, p2, _ = spread(wk * np.logspace(-0.02, 0.02, 81))
+        h2, w2, p2 = spread(wk * np.logspace(-0.02, 0.02, 81))
         if h2 > half:
             half, wk, pair = h2, w2, p2
-    return WzFloor(float(Ww * half), float(wk), pair, n)
+    return WzFloor(float(Ww * half), float(wk), pair, len(systems))
 
 
 def spread_weight(true, *, excitation: str, measurement: str, omega=None, floor: float = 0.02,
@@ -714,14 +725,9 @@ def spread_weight(true, *, excitation: str, measurement: str, omega=None, floor:
     ModelError
         A true system without uncertainty (no spread to follow), a bad grid.
     """
-    from .uncertain import UncertainModel
-    if not isinstance(true, UncertainModel):
-        raise ModelError("a weight shaped by the spread of the true systems needs an uncertain true model "
-                         f"(mutext.uncertain.UncertainModel), got {type(true).__name__}")
-    omega = _floor_grid(true, omega, "spread_weight")
-    half, _, _ = _true_spread(true, excitation, measurement, omega, rng)
+    omega, half = _true_spread(true, excitation, measurement, omega, rng, "spread_weight")
     if not half.max() > 0:
-        raise ModelError("the true systems do not spread on this grid: no shape to follow")
+        raise ModelError("spread_weight: the true systems do not spread on this grid: no shape to follow")
     return fit_envelope(omega, half / half.max(), floor=floor, max_sections=max_sections)
 
 
@@ -915,8 +921,9 @@ def identify(true, engineering, *, excitation: str, measurement: str, control_in
     floor = wz_floor(true, excitation=excitation, measurement=measurement, Ww=Ww, omega=omega, shape=shape)
     Wz, notes = _first_wz(Wz, diff, floor)
     if shape is not None:
+        S = np.abs(shape(omega))
         notes.append(f"error bound shaped by the spread of the true systems: W_z |S(jw)|, |S| from "
-                     f"{np.abs(shape(omega)).min():.3g} to {np.abs(shape(omega)).max():.3g} on the grid "
+                     f"{S.min():.3g} to {S.max():.3g} on the grid "
                      f"(a cover of the spread, at most {np.exp(shape.error):.2f} times it)")
     if floor.value > 0:
         say(f"W_z floor {floor.value:.4g} (spread of {floor.samples} true systems at {floor.omega:.4g} rad/s)")

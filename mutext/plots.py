@@ -296,7 +296,7 @@ def mbi_figure(result, true_systems, Du=None, title=None):
     a = ax[1, 1]
     for k, T in enumerate(true_systems):
         a.loglog(w, result.error(T), color="C0", alpha=0.6, lw=1, label="true samples" if k == 0 else None)
-    if getattr(result.plant, "Wz_shape", None) is None:
+    if result.plant.Wz_shape is None:
         a.axhline(result.Wz, color="C3", ls="--", label=f"$W_z$ = {result.Wz:.3g}")
     else:       # a bound shaped by the spread of the true systems
         a.loglog(w, result.bound(w), color="C3", ls="--", label=f"$W_z|S|$, $W_z$ = {result.Wz:.3g}")

@@ -69,12 +69,10 @@ def solve(trial: str = "1a", out=sys.stderr, measured=None, progress=None, real:
     if measured is not None:
         args["true"] = measured
     # the identified K is one of many controllers that meet the bound. With the flat bound the
-    # LMI construction is the steadier one on this rig; on the plant shaped by the spread it is
-    # the Riccati central controller that certifies (trial 5: 6.0 mm against 26 mm with the LMI one)
-    # With the bound shaped by the spread each try is the H-infinity design alone: the D steps that
-    # follow raise the D-G bound the search judges by (trial 5: the full iteration keeps the first
-    # loop too, and the same W_z, in minutes instead of seconds, its later K steps being LMIs of
-    # 35 states)
+    # LMI construction is the steadier one on this rig. With the bound shaped by the spread the
+    # Riccati central controller certifies (trial 5: 6.0 mm, the LMI one 26 mm), and each try is
+    # that H-infinity design alone: the D steps that follow raise the D-G bound the search judges
+    # by, so the full iteration keeps the same loop, in minutes instead of seconds
     synthesis = {"synthesis": "lmi-first"} if weight == "flat" else {"max_iter": 1}
     res = identify(**args, Wz=None if measured is not None else tr.Wz, out=out, progress=progress,
                    dk_options={**synthesis, **(dk_options or {})}, real=real, branch=branch, weight=weight)
