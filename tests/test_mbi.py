@@ -11,6 +11,8 @@ import control as ct
 import numpy as np
 import pytest
 
+from three_mass_plain import half_gaps
+
 from mutext.errors import IllPosedError, ModelError
 from mutext.examples import three_mass as tm
 from mutext.lti import freqresp, lft_lower, mck_to_ss
@@ -241,21 +243,6 @@ def test_identify_names_a_bad_branch_option():
         identify(**tm.mbi_arguments(tm.TRIALS["1a"]), branch="yes")
 
 
-def _half_gaps(trial, w):
-    """Half the widest gap between the cart-1 responses of the trial's true rigs (changed
-    parameters on a 5-level grid), solved from the M, C, K matrices, not through the LFT."""
-    import itertools
-    tr = tm.TRIALS[trial]
-    names = tm._changed(tr)
-    X = []
-    for levels in itertools.product(np.linspace(-1, 1, 5), repeat=len(names)):
-        p = tr.true.with_(**{n: getattr(tr.true, n) * (1 + tr.uncertainty * x) for n, x in zip(names, levels)})
-        M, C, K = tm.matrices(p)
-        X.append([np.linalg.solve(K - x * x * M + 1j * x * C, [1.0, 0, 0])[0] for x in w])
-    X = np.array(X)
-    return np.array([np.abs(X - X[i]).max(axis=0) for i in range(len(X))]).max(axis=0) / 2
-
-
 def test_spread_weight_covers_the_spread_and_sets_the_shaped_floor():
     """The shape covers the half-gaps of the true rigs at every grid frequency, tightly where
     they are widest and at low frequency; the shaped floor is their largest ratio to it."""
@@ -263,7 +250,7 @@ def test_spread_weight_covers_the_spread_and_sets_the_shaped_floor():
     args = tm.mbi_arguments(tm.TRIALS["5"])
     w = np.logspace(np.log10(0.5), np.log10(300), 300)
     S = spread_weight(args["true"], excitation="f1", measurement="x1", omega=w)
-    half = _half_gaps("5", w)
+    half = half_gaps("5", w)
     Sj = np.abs(freqresp(S.sys, w)[0, 0])
     ratio = half / Sj
     f = wz_floor(args["true"], excitation="f1", measurement="x1", omega=w, shape=S)
