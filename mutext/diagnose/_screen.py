@@ -163,6 +163,14 @@ def _fit_size(ev: _Evaluator, n_scan: int = 25, gn_iter: int = 30):
     k = int(np.argmin(vals))
     t, best = grid[k], vals[k]
     if h.crack is not None:
+        # the bounds belong to the scan (the log grid's last point below a depth ratio of 0.5 is 0.464):
+        # a crack at or near its bound must be reachable
+        for e in (h.lower, h.upper):
+            if e not in grid:
+                grid.append(e)
+                v = rss(e)
+                if v < best:
+                    t, best = e, v
         # one-dimensional and smooth: golden-section refinement between the scan neighbours
         srt = sorted(grid)
         j = srt.index(t)
