@@ -15,8 +15,34 @@ solved in first-order form :math:`\dot x = A x`,
 (Friswell et al. 2010, ch. 3 and 5).  Without damping and rotation the
 symmetric-definite problem :math:`K\phi = \omega^2 M\phi` is solved instead
 (``scipy.linalg.eigh``), which is more accurate.  Natural frequencies are the
-imaginary parts :math:`\omega_d = \mathrm{Im}\,\lambda > 0`; rigid-body modes
-(:math:`|\lambda|` below ``1e-6`` times the largest) are left out.
+imaginary parts :math:`\omega_d = \mathrm{Im}\,\lambda > 0` of the underdamped
+modes; two kinds of root are left out:
+
+* rigid-body modes: the modes of the undamped, non-rotating structure whose
+  :math:`\omega^2` is zero to rounding, :math:`\omega^2 \le \epsilon_r^2\,\omega_s^2`
+  (``rigid_tol`` :math:`= \epsilon_r = 10^{-6}`), with :math:`\omega_s^2` the
+  largest eigenvalue of :math:`(K, M)`: the structure's stiffness-to-mass
+  scale, which damping and speed leave alone.  A structure without such
+  modes (a rotor on bearings, a grounded chain) loses no root as rigid; one
+  with them loses its roots with :math:`|\lambda| \le \epsilon_r\omega_s`.  The
+  roots of the damped problem set no threshold: with stiffness-proportional
+  damping the top modes of a fine mesh are overdamped, with real roots near
+  :math:`-\beta\omega^2` far above every vibration, and a cut relative to the
+  largest root drops real modes (it took the thesis rotor's 34 Hz pair at
+  :math:`\beta = 10^{-4}`).
+* overdamped modes: a root whose mode shape :math:`\hat q` has more than
+  critical damping,
+
+  .. math:: \hat q^H C_s\,\hat q \ge 2\sqrt{(\hat q^H K\hat q)(\hat q^H M\hat q)} ,
+
+  with :math:`C_s` the symmetric part of :math:`C + \Omega G` (the gyroscopic
+  part is skew and drops out), is a creep, not a vibration.  Without rotation
+  this is exactly :math:`\mathrm{Im}\,\lambda = 0` (the scalar quadratic
+  :math:`m\lambda^2 + c\lambda + k = 0` of the exact eigenvector has complex roots
+  only below critical damping); at speed the gyroscopic coupling of the two
+  planes makes the overdamped roots slightly complex
+  (:math:`\lambda \approx -1/\beta \pm j\,O(\Omega)`), and this test still
+  recognises them.
 
 Whirl direction
 ---------------
@@ -44,6 +70,7 @@ Rotating Machines*, Cambridge University Press, 2010, ch. 3 and 5.
 """
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass, field
 from typing import Sequence
 
@@ -191,7 +218,10 @@ def modes(model, *, speed: float | None = None, values=None, n: int | None = Non
     n : int, optional
         Keep the ``n`` lowest modes.
     rigid_tol : float
-        Relative threshold below which a mode counts as rigid-body and is dropped.
+        A mode of the undamped structure whose natural frequency is below
+        ``rigid_tol`` times the largest one of :math:`(K, M)` is rigid-body
+        (zero to rounding) and is dropped, with or without damping and speed
+        (see the module docstring).  Overdamped roots are dropped too.
     matrices : Matrices, optional
         Precomputed ``model.matrices(values)``.
     """
@@ -216,8 +246,9 @@ def _modes(model, speed, values, n, rigid_tol, matrices) -> Modes:
     for name, X in (("mass", M), ("damping", D), ("stiffness", K)):
         if not np.all(np.isfinite(X)):
             raise ModelError(f"{model.name}: the {name} matrix has non-finite entries (check the parameter values)")
+    Ks = 0.5 * (K + K.T)
     if not np.any(D):
-        lam, Phi = sla.eigh(0.5 * (K + K.T), M)
+        lam, Phi = sla.eigh(Ks, M)
         scale = max(float(np.max(np.abs(lam))), 1e-300)
         if lam.min() < -rigid_tol**2 * scale:
             raise IllPosedError(_divergence(model, np.sqrt(-lam[lam < -rigid_tol**2 * scale])))
@@ -227,18 +258,7 @@ def _modes(model, speed, values, n, rigid_tol, matrices) -> Modes:
         shapes = Phi[:, keep].astype(complex)
         zeta = np.zeros_like(w)
     else:
-        Minv = np.linalg.inv(M)
-        A = np.block([[np.zeros((ndof, ndof)), np.eye(ndof)], [-Minv @ K, -Minv @ D]])
-        lam, X = sla.eig(A)
-        scale = max(float(np.max(np.abs(lam))), 1e-300)
-        diverging = lam[(np.abs(lam.imag) <= rigid_tol * scale) & (lam.real > rigid_tol * scale)]
-        if diverging.size:
-            raise IllPosedError(_divergence(model, diverging.real))
-        keep = lam.imag > rigid_tol * scale
-        ev = lam[keep]
-        order = np.argsort(ev.imag)
-        ev = ev[order]
-        shapes = X[:ndof, keep][:, order]
+        ev, shapes = _damped_modes(M, D, K, Ks, rigid_tol, model)
         w = ev.imag
         zeta = -ev.real / np.abs(ev)
     if n is not None:
@@ -249,6 +269,38 @@ def _modes(model, speed, values, n, rigid_tol, matrices) -> Modes:
             shapes[:, r] = shapes[:, r] / shapes[k, r]
     whirl = np.array([whirl_index(shapes[:, r], model.layout) for r in range(shapes.shape[1])])
     return Modes(ev, w, w / (2 * np.pi), zeta, shapes, whirl, speed, model.dof_names)
+
+
+def _damped_modes(M, D, K, Ks, rigid_tol, model):
+    """Underdamped, non-rigid roots (Im > 0, sorted) and their displacement shapes, from the first-order form.
+
+    Rigid-body roots are recognised against the undamped structure's scale ``omega_s^2`` (the largest
+    eigenvalue of (K, M)), overdamped ones by their shape's damping (see the module docstring): the
+    roots of the damped problem, whose largest is the overdamped ``-beta omega^2`` of the top mode
+    with stiffness-proportional damping, set no threshold."""
+    ndof = M.shape[0]
+    lam_u = sla.eigvalsh(Ks, M)
+    scale = max(float(np.max(np.abs(lam_u))), 1e-300)          # omega_s^2
+    n_rigid = int(np.sum(np.abs(lam_u) <= rigid_tol**2 * scale))
+    cut = rigid_tol * math.sqrt(scale)                          # rigid_tol * omega_s [rad/s]
+    Minv = np.linalg.inv(M)
+    A = np.block([[np.zeros((ndof, ndof)), np.eye(ndof)], [-Minv @ K, -Minv @ D]])
+    lam, X = sla.eig(A)
+    diverging = lam[(np.abs(lam.imag) <= cut) & (lam.real > cut)]
+    if diverging.size:
+        raise IllPosedError(_divergence(model, diverging.real))
+    cand = np.flatnonzero(lam.imag > 0)
+    if n_rigid:
+        cand = cand[np.abs(lam[cand]) > cut]
+    Q = X[:ndof, cand]
+    m = np.real(np.sum(np.conj(Q) * (M @ Q), axis=0))
+    k = np.real(np.sum(np.conj(Q) * (Ks @ Q), axis=0))
+    c = np.real(np.sum(np.conj(Q) * ((0.5 * (D + D.T)) @ Q), axis=0))
+    under = (c <= 0.0) | (c < 2.0 * np.sqrt(np.maximum(k, 0.0) * m))     # no dissipation, or below critical
+    keep = cand[under]
+    ev = lam[keep]
+    order = np.argsort(ev.imag)
+    return ev[order], X[:ndof, keep][:, order]
 
 
 def _divergence(model, rates) -> str:

@@ -20,6 +20,10 @@ every element:
 ``lumped_elements``
     :class:`Spring` and :class:`Damper` of lumped mass-spring-damper chains.
 
+:class:`StructuralDamping` (here) is the proportional damping of a model
+file's ``[damping] alpha, beta``: :math:`\alpha M` and :math:`\beta` times the
+stiffness of the structure's own members, not of its connections to ground.
+
 The crack element lives with its fracture mechanics in
 :mod:`mutext.rotor.crack`.  :class:`mutext.rotor.assembly.Structure`
 assembles the elements.
@@ -57,9 +61,11 @@ References
 """
 from __future__ import annotations
 
+import casadi as ca
+
 from .bearing_element import BearingElement
 from .disk_element import DiskElement, PointMass
-from .element import Element, InputPort, Layout, OutputPort, Param, ParameterSet
+from .element import Element, InputPort, Layout, OutputPort, Param, ParameterSet, _positive
 from .exciter_element import ExciterElement
 from .lumped_elements import Damper, Spring
 from .shaft_element import (  # noqa: F401  (the plane maps, used by the crack element)
@@ -76,8 +82,64 @@ from .shaft_element import (  # noqa: F401  (the plane maps, used by the crack e
 __all__ = [
     "Param", "ParameterSet", "Layout", "InputPort", "OutputPort", "Element",
     "ShaftElement", "DiskElement", "BearingElement", "ExciterElement",
-    "PointMass", "Spring", "Damper",
+    "PointMass", "Spring", "Damper", "StructuralDamping",
     "section_properties", "cowper_shear_coefficient", "timoshenko_plane_matrices",
     "timoshenko_shape_functions", "plane_to_rotor",
 ]
 
+
+
+class StructuralDamping(Element):
+    r"""Proportional damping of a structure's own members: :math:`C \mathrel{+}= \alpha M + \beta K_s`.
+
+    ``alpha`` [1/s] multiplies the whole mass matrix.  ``beta`` [s] multiplies
+    :math:`K_s`, the stiffness of the structure's *members*: every element
+    except the connections to ground -- bearings, exciters (their negative
+    stiffness) and springs with one end on the ground.  Those carry only the
+    damping they are given (a bearing's ``damping``, a ``[[damper]]``), so a
+    grounded spring or bearing added to a model (as :mod:`mutext.diagnose`
+    adds one to the model file) leaves the damping matrix as it was.  Shaft
+    elements, cracks (they lower the shaft's stiffness, and its damping with
+    it) and springs between two masses are members.
+
+    This is what a model file's ``[damping] alpha, beta`` builds
+    (:mod:`mutext.rotor.model`); :class:`mutext.rotor.assembly.ProportionalDamping`
+    is the plain :math:`\alpha M + \beta K` of the whole assembled model.  The
+    element spans all nodes and reads the other elements of its structure
+    when bound; its parameters are ``"<name>.alpha"`` and ``"<name>.beta"``
+    (``"damping.alpha"``, ``"damping.beta"``).
+    """
+    KIND = "damping"
+    FIELDS = {"alpha": ("1/s", "mass-proportional damping coefficient"),
+              "beta": ("s", "stiffness-proportional damping coefficient of the structure's members")}
+
+    def __init__(self, alpha=0.0, beta=0.0, *, name: str = "damping"):
+        super().__init__((1,), name, alpha=alpha, beta=beta)
+        _positive(self, "alpha", "beta", allow_zero=True)
+        self.members: list = []
+
+    def bind(self, structure):
+        self.members = [el for el in structure.elements if el is not self]
+
+    @staticmethod
+    def grounded(el) -> bool:
+        """True for a connection to ground (no stiffness-proportional damping)."""
+        return isinstance(el, (BearingElement, ExciterElement)) or (isinstance(el, Spring) and len(el.nodes) == 1)
+
+    def dofs(self, layout):
+        return list(range(layout.ndof))
+
+    def damping_matrix(self, p, layout):
+        n = layout.ndof
+        C = ca.SX(n, n)
+        a, b = self.sym(p, "alpha"), self.sym(p, "beta")
+        for el in self.members:
+            idx = el.dofs(layout)
+            Me = el.mass_matrix(p, layout)
+            if Me is not None:
+                C[idx, idx] = C[idx, idx] + a * ca.SX(Me)
+            if not self.grounded(el):
+                Ke = el.stiffness_matrix(p, layout)
+                if Ke is not None:
+                    C[idx, idx] = C[idx, idx] + b * ca.SX(Ke)
+        return C

@@ -61,6 +61,7 @@ Rotor files
 
     [damping]
     modal = 0.01                  # same ratio in every mode ... or alpha = ..., beta = ...
+                                  # (proportional: see "Damping" below)
 
     [[crack]]                     # needs mutext.rotor.crack
     station = 15
@@ -93,11 +94,35 @@ Lumped chains
     name = "x1"
     mass = "m1"
 
+Damping
+-------
+``[damping] modal = z`` gives every mode of the undamped structure the damping
+ratio *z* (:class:`~mutext.rotor.assembly.ModalDamping`, recomputed from the
+modes of the model as built, added elements included).
+
+``[damping] alpha = a, beta = b`` is proportional damping
+(:class:`~mutext.rotor.elements.StructuralDamping`): :math:`C \mathrel{+}=
+\alpha M + \beta K_s`.  ``alpha`` [1/s] multiplies the whole mass matrix;
+``beta`` [s] multiplies :math:`K_s`, the stiffness of the structure's own
+members only -- the shaft elements and the cracks in them (rotors), the
+springs between two masses (lumped chains).  The connections to ground --
+``[[bearing]]``, ``[[exciter]]`` (its negative stiffness) and a ``[[spring]]``
+with one end on ``"ground"`` -- carry only the damping they are given (a
+bearing's ``damping``, a ``[[damper]]``): a grounded spring or bearing added
+to the file, e.g. ``damping = 0.0`` by :mod:`mutext.diagnose`, leaves the
+damping matrix unchanged.  (A structural spring to ground that should share
+the material damping needs its own ``[[damper]]``, of value
+:math:`\beta k`.)  A mode of a structure without such connections gets
+:math:`\zeta = \alpha/(2\omega) + \beta\omega/2`; with them the
+:math:`\beta` term is about :math:`\beta\omega/2` times the share of the
+mode's strain energy stored in the members.
+
 The parameter of a lumped element is called by the element's name (``"m1"``,
 ``"k1"``, ``"c1"``).  In rotors: ``"E"`` and ``"rho"`` (one each when all
 shaft elements share the value, else ``"shaft<s>.E"``), ``"nu"`` or ``"G"``,
 ``"shaft<s>.L"``, ``".do"``, ``".di"``, ``"disk<s>.m"``, ``".Ip"``, ``".Id"``,
-``"bearing<s>.k"``, ``".c"``, ``"exciter<s>.ki"``, ``".kx"``.
+``"bearing<s>.k"``, ``".c"``, ``"exciter<s>.ki"``, ``".kx"``; proportional damping:
+``"damping.alpha"``, ``"damping.beta"``.
 
 Errors name the file, the table (``[[bearing]] #2``) and key, and the problem.
 """
@@ -111,9 +136,9 @@ from typing import Any
 
 from ..errors import ModelError
 from . import units as U
-from .assembly import ModalDamping, ProportionalDamping, Rotor, Structure
+from .assembly import ModalDamping, Rotor, Structure
 from .elements import (BearingElement, Damper, DiskElement, ExciterElement, InputPort, OutputPort, Param,
-                       PointMass, ShaftElement, Spring)
+                       PointMass, ShaftElement, Spring, StructuralDamping)
 from .table import Station, StationTable, read_station_table
 
 __all__ = ["load_model", "loads_model", "rotor_from_table", "DEFAULT_POISSON_RATIO"]
@@ -424,6 +449,9 @@ def _load_rotor(ctx: _Ctx, doc: dict, base_dir: str, station_table=None) -> Roto
         s = ctx.station(t, where, n - 1)
         extra.append(_make_crack(ctx, t, where, s))
     damping = _damping(ctx, doc.get("damping"))
+    if isinstance(damping, StructuralDamping):          # an element: it knows which elements are members
+        extra.append(damping)
+        damping = None
     try:
         rotor = rotor_from_table(table, poisson_ratio=nu, shear_modulus=G, ports_from_flags=ports,
                                  extra_elements=extra, inputs=ins, outputs=outs, planes=planes, speed=speed,
@@ -475,7 +503,7 @@ def _damping(ctx, d):
     if "alpha" in d or "beta" in d:
         a = ctx.number(d, "alpha", "dimensionless", "[damping]", default=0.0)
         b = ctx.number(d, "beta", "dimensionless", "[damping]", default=0.0)
-        return ProportionalDamping(a, b)
+        return StructuralDamping(a, b)
     raise ctx.err("[damping]", "expected 'modal' or 'alpha'/'beta'")
 
 
@@ -538,6 +566,9 @@ def _load_lumped(ctx: _Ctx, doc: dict) -> Structure:
                 raise ctx.err(f"{where}, mass", f"unknown mass '{m}' (masses: {', '.join(node)})")
             lst.append(cls(ctx.string(t, "name", where), node[m], "x"))
     damping = _damping(ctx, doc.get("damping"))
+    if isinstance(damping, StructuralDamping):
+        els.append(damping)
+        damping = None
     if not masses:
         raise ctx.err("[[mass]]", "a lumped model needs at least one mass")
     try:
