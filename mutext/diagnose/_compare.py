@@ -45,8 +45,12 @@ def _model_resonances(fm, zm, band):
     return [(float(np.mean(f)), float(np.mean(z))) for f, z in out]
 
 
-def _resonance_table(chans, before, model, speed, noise) -> list[ResonanceRow]:
-    """Measured resonances matched one to one to the model's (nearest in log frequency, within 50 %)."""
+def _resonance_table(chans, before, model, speed, noise, unmatched: dict | None = None) -> list[ResonanceRow]:
+    """Measured resonances matched one to one to the model's (nearest in log frequency, within 50 %).
+
+    ``unmatched``, when given, receives ``"measured"``: the resonances found in the data that no model
+    resonance is matched to (reliable ones only: found in most bootstrap refits), and ``"model"``: the
+    model's resonances outside the measured band."""
     from scipy.optimize import linear_sum_assignment
     rows = []
     try:
@@ -54,6 +58,11 @@ def _resonance_table(chans, before, model, speed, noise) -> list[ResonanceRow]:
     except Exception as exc:  # pragma: no cover
         log.debug("model modes failed: %s", exc)
         return rows
+    if unmatched is not None:
+        lo = min(c.frf.freq_hz[0] for c in chans)
+        hi = max(c.frf.freq_hz[-1] for c in chans)
+        unmatched["model"] = [float(f) for f, _ in _model_resonances(fm, zm, (0.0, np.inf)) if not lo <= f <= hi]
+        unmatched["measured"] = []
     for ch, Hb in zip(chans, before):
         f = ch.frf.freq_hz
         try:
@@ -62,12 +71,18 @@ def _resonance_table(chans, before, model, speed, noise) -> list[ResonanceRow]:
             log.debug("no resonances for %s: %s", ch.label, exc)
             continue
         mods = _model_resonances(fm, zm, (f[0], f[-1]))
-        if not res or not mods:
-            continue
-        cost = np.abs(np.log(np.array([r.freq_hz for r in res])[:, None] / np.array([m[0] for m in mods])[None]))
-        for i, j in zip(*linear_sum_assignment(cost)):
-            if cost[i, j] > math.log(1.5):
-                continue
+        matched = set()
+        if res and mods:
+            cost = np.abs(np.log(np.array([r.freq_hz for r in res])[:, None] / np.array([m[0] for m in mods])[None]))
+            pairs = [(i, j) for i, j in zip(*linear_sum_assignment(cost)) if cost[i, j] <= math.log(1.5)]
+        else:
+            pairs = []
+        if unmatched is not None:
+            matched = {i for i, _ in pairs}
+            unmatched["measured"] += [{"channel": ch.label, "freq_hz": r.freq_hz, "freq_std": r.freq_std,
+                                       "damping_ratio": r.damping_ratio}
+                                      for i, r in enumerate(res) if i not in matched and math.isfinite(r.freq_std)]
+        for i, j in pairs:
             r, (fmod, zmod) = res[i], mods[j]
             peak_model = float(np.interp(fmod, f, np.abs(Hb)))
             rows.append(ResonanceRow(ch.label, r.freq_hz, r.freq_std, fmod, r.damping_ratio, r.damping_std, zmod,

@@ -11,17 +11,20 @@ import numpy as np
 import scipy.stats as sst
 
 from ..errors import ModelError
-from ..frfit import noise_level
+from ..lti import blas_single_thread
 from ..response import FRF
 from ..rig import read_frfs
 from ..rotor.model import load_model, loads_model
 from ..rotor.tuning import model_response
 from ._compare import _errors, _model_modes, _resonance_table, _summary
 from ._extend import _refit, extended_model_text, mbi_reading, write_model
-from ._hypotheses import Hypothesis, _gain_hypotheses, hypotheses
+from ._hypotheses import Hypothesis, hypotheses
+from .faults import channel as _channel
 from ._result import ChannelComparison, Diagnosis, Finding
 from ._channels import _resolve, _src
+from ._fit_quality import fit_quality, noise_reference
 from ._screen import _Data, _Evaluator, _Receptance, _fit_size, _jacobian_std, _rss, _separating_station
+from ._select import MAX_EFFECTS, Compound, _rss_of, at_bound, fit_one_given, joint_fit
 
 log = logging.getLogger("mutext.diagnose")
 
@@ -71,7 +74,7 @@ def diagnose(model, frfs, validate=None, *, alpha: float = 0.01, refit: int = 3,
         :func:`mutext.rotor.tuning.tune`.
     noise : float, optional
         Relative noise level; default estimated from the data
-        (:func:`mutext.frfit.noise_level`).
+        (model-free rational fits, :mod:`mutext.diagnose._fit_quality`).
     out_dir : path, optional
         Write ``model_extended.toml`` there (:func:`write_model`; :func:`mutext.report.write_diagnosis`
         writes the report and figures too).
@@ -106,6 +109,11 @@ def diagnose(model, frfs, validate=None, *, alpha: float = 0.01, refit: int = 3,
     >>> bool(d.gain > 3)
     True
     """
+    with blas_single_thread():        # small dense problems: extra BLAS threads only spin on a busy machine
+        return _diagnose(model, frfs, validate, alpha, refit, noise, out_dir, progress, only, mbi)
+
+
+def _diagnose(model, frfs, validate, alpha, refit, noise, out_dir, progress, only, mbi) -> Diagnosis:
     t0 = time.perf_counter()
 
     def tell(stage, frac):
@@ -114,7 +122,9 @@ def diagnose(model, frfs, validate=None, *, alpha: float = 0.01, refit: int = 3,
             progress(stage, frac)
 
     path, eng, model_text, chans, vchans, speed = _inputs(model, frfs, validate, alpha)
-    noise = _noise(chans, noise)
+    tell("noise level of the data (model-free rational fits)", 0.01)
+    ref = noise_reference(chans, _noise(noise))
+    noise = ref.sigma
     s2 = noise ** 2 / 2.0
     tell("engineering model's receptance", 0.02)
     allf = np.unique(np.concatenate([c.frf.freq_hz for c in chans + vchans]))    # one grid for all
@@ -123,11 +133,13 @@ def diagnose(model, frfs, validate=None, *, alpha: float = 0.01, refit: int = 3,
 
     # 1. what the simulation gets wrong
     before = all_fit.H0
-    rows = _resonance_table(chans, before, eng, speed, noise)
+    unmatched: dict = {}
+    rows = _resonance_table(chans, before, eng, speed, noise, unmatched)
+    unmatched["measured"] = _group_unmatched(unmatched.get("measured", []))
     summary = _summary(rows, chans, before)
 
     # 2. the hypotheses, screened, the best refitted on the extended model, the verdict
-    hyps = hypotheses(eng) + _gain_hypotheses(eng, chans)
+    hyps = hypotheses(eng) + _channel.candidates(eng, chans)
     if only is not None:
         hyps = [h for h in hyps if only(h)]
         if not hyps:
@@ -137,15 +149,36 @@ def diagnose(model, frfs, validate=None, *, alpha: float = 0.01, refit: int = 3,
     threshold = float(sst.chi2.isf(alpha / len(hyps), 1))
     findings = _screen_all(hyps, rec, fit, s2, N, rss0, threshold, tell)
     notes = _refit_best(findings, refit, model_text, path, eng, fit, s2, N, rss0, threshold, tell)
+    for f in findings:
+        _judge(f, N, threshold)
+    for f in findings[:5]:
+        if f.at_bound:
+            notes.append(f"{f.description} fits best at the bound of its range ({f.value:.4g} {f.unit}): "
+                         "not accepted (the data ask for more than the hypothesis allows)")
     none = Finding("none", None, None, 0.0, "", 0.0, rss0 / s2, 0.0, "no effect beyond the noise")
     findings.sort(key=lambda f: f.score)
     findings.insert(next((i for i, f in enumerate(findings) if f.score > none.score), len(findings)), none)
-    verdict, ambiguous, sensor = _decide(findings, none, threshold, N, rec, fit, eng, notes)
+    verdict, ambiguous, sensor = _decide(findings, none, threshold, N, rec, fit, eng, notes, held, s2)
 
-    # 3. the extended model and its gain on held-out data
+    # 3. goodness of fit; further effects while the residual stays above the noise
+    effects = [] if verdict is none else [verdict]
+    effects, quality = _select_more(effects, hyps, rec, fit, held, s2, N, threshold, alpha, ref, notes, tell)
+    if len(effects) > 1:
+        verdict = effects[0]
+
+    # 4. the extended model and its gain on held-out data
     tell("held-out gain", 0.95)
-    text = extended_model_text(model_text, verdict, eng) if verdict is not none else None
-    after_all, after_held = _after(verdict, text, path, rec, chans, all_fit, held)
+    text = None
+    if effects:
+        text = model_text
+        for e in effects:
+            text = extended_model_text(text, e, eng)
+    if len(effects) > 1:
+        comp = [e.hypothesis for e in effects], [e.value for e in effects]
+        after_all = Compound(rec, all_fit, comp[0]).responses(comp[1])
+        after_held = Compound(rec, held, comp[0]).responses(comp[1])
+    else:
+        after_all, after_held = _after(verdict, text, path, rec, chans, all_fit, held)
     err_before = _errors(held.H0, held.meas)
     err_after = _errors(after_held, held.meas)
     gain = err_before["rel"] / err_after["rel"] if err_after["rel"] > 0 else math.inf
@@ -154,16 +187,37 @@ def diagnose(model, frfs, validate=None, *, alpha: float = 0.01, refit: int = 3,
     comps += [ChannelComparison(c.label, _src(c.frf, k + 1), c.frf.freq_hz, c.frf.response, held.H0[k],
                                 None if verdict is none else after_held[k], "validate")
               for k, c in enumerate(vchans)]
+    status = _status(effects, quality, gain)
+    if effects and not quality.at_noise:
+        infl = math.sqrt(max(quality.misfit, 1.0))
+        for e in effects:
+            e.std *= infl
+        notes.append(f"the residual is above the noise: the effects' uncertainties are inflated by "
+                     f"sqrt(misfit) = {infl:.3g}")
+    if effects and not gain > 1:
+        notes.append(f"the extended model fits the held-out data worse than the engineering model "
+                     f"(gain {gain:.3g}x): it is not a fix")
     result = Diagnosis(eng.name, path, noise, findings, verdict, ambiguous, sensor, err_before, err_after, gain,
                        held_desc, comps, rows, summary, threshold, alpha, len(hyps), text,
-                       time.perf_counter() - t0, notes, N)
+                       time.perf_counter() - t0, notes, N, status=status, effects=effects, fit_quality=quality,
+                       noise_reference=ref, unmatched=unmatched)
     if speed > 0 and hasattr(eng, "n_stations"):
-        result.sidebands = _sidebands(eng, speed, chans, verdict, result.notes)
+        # where to look: the modes of the best time-invariant model (a mode the engineering model misplaces
+        # is not a sideband)
+        best_ti = eng
+        if text is not None and any(e.hypothesis.gain is None for e in effects):
+            try:
+                best_ti = loads_model(text, source=f"{path} (extended)",
+                                      base_dir=os.path.dirname(os.path.abspath(path)))
+            except ModelError:
+                pass
+        result.sidebands = _sidebands(best_ti, speed, chans)
         if result.sidebands and result.sidebands["verdict"] != "none" and model_text is not None:
             tell("a crack that turns with the shaft, at the best crack station (time-periodic fit)", 0.96)
             result.breathing = _breathing(findings, result.sidebands, model_text, path, speed, chans, fit,
                                           held, s2, rss0, verdict, err_after, result.notes)
             result.seconds = time.perf_counter() - t0
+        _sideband_claim(result)
     if mbi and verdict is not none:
         tell("model-based identification at the finding (D-K iteration)", 0.97)
         try:
@@ -200,23 +254,46 @@ def _breathing(findings, sidebands, model_text, path, speed, chans, fit, held, s
     return out
 
 
-def _sidebands(eng, speed, chans, verdict, notes):
+def _sidebands(model, speed, chans):
     """Sideband evidence on the channels that share the first one's grid (data taken at speed)."""
     from ._sidebands import sideband_evidence
     f0 = chans[0].frf.freq_hz
     same = [c.frf for c in chans if c.frf.freq_hz.shape == f0.shape and np.allclose(c.frf.freq_hz, f0)]
-    fm, _ = _model_modes(eng, speed)
+    fm, _ = _model_modes(model, speed)
     try:
         ev = sideband_evidence(same, fm, speed / (2 * math.pi))
     except ModelError as exc:
-        notes.append(f"sideband evidence not computed: {exc}")
-        return None
-    if ev.verdict != "none":
-        notes.append(f"the data show sidebands ({ev.verdict}): the rotor is time-periodic, which no "
-                     f"time-invariant hypothesis above can hold; {ev.meaning()}"
-                     + (". The crack finding describes its stiffness averaged over a revolution"
-                        if verdict.kind == "crack" else ""))
+        return {"verdict": "none", "meaning": f"not computed: {exc}", "candidates": [], "speed_hz":
+                speed / (2 * math.pi), "orders_found": []}
     return ev.to_dict()
+
+
+def _sideband_claim(result) -> None:
+    """The time-periodic claim is made only when a time-periodic model fits better than the time-invariant
+    one; otherwise the sidebands are reported as not explaining the data."""
+    sb, b = result.sidebands, result.breathing
+    if not sb or sb["verdict"] == "none":
+        return
+    worse = None
+    if b is not None:
+        d = b.get("delta_chi2_vs_time_invariant")
+        ti = (b.get("time_invariant_crack") or {}).get("held_out_error")
+        if d is not None and d < 0:
+            worse = f"it fits the measured data worse (delta chi2 {d:.1f})"
+        elif ti and b["held_out_error"]["rel"] > ti["rel"]:
+            worse = (f"it fits the held-out data worse ({100 * b['held_out_error']['rel']:.3g} % against "
+                     f"{100 * ti['rel']:.3g} %)")
+    if worse:
+        result.notes.append(f"sideband-like peaks were found ({sb['verdict']}), but the time-periodic (breathing "
+                            f"crack) model does not explain them: {worse}; no time-periodic claim is made")
+        sb["verdict_found"], sb["verdict"] = sb["verdict"], "none"
+        sb["meaning"] = "peaks near f_n -/+ kF that a time-periodic model does not explain"
+        b["rejected"] = worse
+        return
+    result.notes.append(f"the data show sidebands ({sb['verdict']}): the rotor is time-periodic, which no "
+                        f"time-invariant hypothesis above can hold; {sb['meaning']}"
+                        + (". The crack finding describes its stiffness averaged over a revolution"
+                           if result.verdict.kind == "crack" else ""))
 
 
 def _inputs(model, frfs, validate, alpha):
@@ -234,6 +311,13 @@ def _inputs(model, frfs, validate, alpha):
     if not fit_frfs:
         raise ModelError("diagnose: no measured FRF given")
     val_frfs = _as_frfs(validate)
+    for group, what in ((fit_frfs, "measured"), (val_frfs, "validation")):
+        for i, a in enumerate(group):
+            for b in group[:i]:
+                if _same_data(a, b):
+                    raise ModelError(f"{what} data {_src(a, i + 1)} holds the same data as {_src(b, 0)}: the "
+                                     f"same measurement given twice would count as two independent channels "
+                                     f"(uncertainties too small); give it once")
     for v in val_frfs:
         for f in fit_frfs:
             if _same_data(v, f):
@@ -257,15 +341,104 @@ def _inputs(model, frfs, validate, alpha):
     return path, eng, model_text, chans, vchans, speed
 
 
-def _noise(chans, noise) -> float:
-    """The relative noise level: given, or estimated from the data alone (points-weighted rms)."""
+def _noise(noise) -> float | None:
+    """The relative noise level given by the user, checked (None: estimated from the data)."""
     if noise is None:
-        lv = [noise_level(c.frf.freq_hz, c.frf.response) for c in chans]
-        npts = [c.frf.freq_hz.size for c in chans]
-        noise = float(math.sqrt(np.average(np.square(lv), weights=npts)))
-    elif not (isinstance(noise, (int, float)) and math.isfinite(noise) and 0 < noise < 1):
+        return None
+    if isinstance(noise, bool) or not (isinstance(noise, (int, float)) and math.isfinite(noise) and 0 < noise < 1):
         raise ModelError(f"diagnose: noise must be a relative level in (0, 1), e.g. 0.01 for 1 %; got {noise!r}")
     return max(float(noise), 1e-6)
+
+
+def _group_unmatched(rows: list) -> list:
+    """Unmatched measured resonances of several channels merged into one entry per mode (within 2 %)."""
+    out: list = []
+    for r in sorted(rows, key=lambda x: x["freq_hz"]):
+        if out and abs(r["freq_hz"] / out[-1]["freq_hz"] - 1) <= 0.02:
+            if r["channel"] not in out[-1]["channel"].split(", "):
+                out[-1]["channel"] += ", " + r["channel"]
+            continue
+        out.append(dict(r))
+    return out
+
+
+def _judge(f: Finding, N: int, threshold: float) -> None:
+    """Significance as the name says: the improvement passes the test against the larger of the noise and
+    what the hypothesis itself leaves (an F test when the residual is above the noise), and the size
+    does not sit at a bound of its range."""
+    if f.kind == "none" or f.hypothesis is None:
+        return
+    f.at_bound = bool(f.delta_chi2 > 0 and at_bound(f.hypothesis, f.value))
+    left = max(1.0, (f.score - math.log(N)) / max(N - 1, 1))
+    f.significant = bool(f.delta_chi2 / left > threshold and not f.at_bound)
+
+
+def _status(effects, quality, gain) -> str:
+    """Explained: at the noise (and, with effects, better on held-out data); partly: effects that help on
+    held-out data, a residual above the noise; otherwise not explained."""
+    # a channel's scale acts on its own file only: other files cannot confirm it, only not contradict it
+    better = gain > 1 or (bool(effects) and all(e.kind == "channel_scale" for e in effects) and gain >= 1 - 1e-9)
+    if quality.at_noise:
+        return "explained" if (not effects or better) else "not explained"
+    return "partly explained" if (effects and better) else "not explained"
+
+
+def _select_more(effects, hyps, rec, fit, held, s2, N, threshold, alpha, ref, notes, tell):
+    """Forward selection (see :mod:`mutext.diagnose._select`): returns (effects, fit quality of the last model)."""
+    labels = [c.label for c in fit.chans]
+
+    def quality_of(effs, thetas):
+        Hs = Compound(rec, fit, [e.hypothesis for e in effs]).responses(thetas) if effs else fit.H0
+        with np.errstate(all="ignore"):
+            r = [np.log(h / m) for h, m in zip(Hs, fit.meas)]
+        return fit_quality(r, fit.freq_hz, labels, s2, len(effs), ref, alpha)
+
+    thetas = [e.value for e in effects]
+    quality = quality_of(effects, thetas)
+    chi_held = float(sst.chi2.isf(alpha, 1))
+    while effects and not quality.at_noise and len(effects) < MAX_EFFECTS:
+        tell(f"the residual is above the noise: screening a further effect given {len(effects)}", 0.9)
+        base = [e.hypothesis for e in effects]
+        rss_a = _rss_of(Compound(rec, fit, base).responses(thetas), fit.meas)
+        held_a = _rss_of(Compound(rec, held, base).responses(thetas), held.meas)
+        cands = []
+        for h in hyps:
+            if any(h is b for b in base):
+                continue
+            t, r = fit_one_given(rec, fit, base, thetas, h)
+            cands.append((r, id(h), h, t))
+        if not cands:
+            break
+        cands.sort(key=lambda x: x[:2])
+        best = None
+        for r, _, h, t in cands[:3]:
+            th, rss, sd = joint_fit(rec, fit, base + [h], thetas + [t], s2)
+            if best is None or rss < best[1]:
+                best = (h, rss, th, sd)
+        h, rss_new, th, sd = best
+        dchi = (rss_a - rss_new) / s2
+        held_new = _rss_of(Compound(rec, held, base + [h]).responses(th), held.meas)
+        dheld = (held_a - held_new) / s2
+        stuck = [x.description for x, t in zip(base + [h], th) if at_bound(x, t)]
+        left = max(1.0, rss_new / (s2 * max(N - len(th), 1)))
+        if not (dchi / left > threshold and dheld > chi_held and not stuck):
+            why = ("a size at the bound of its range: " + ", ".join(stuck)) if stuck else (
+                f"delta chi2 {dchi:.1f} on the fitted data (threshold {threshold:.1f}"
+                + (f", {threshold * left:.1f} against the misfit left" if left > 1 else "")
+                + f"), {dheld:.1f} on the held-out data (threshold {chi_held:.1f})")
+            notes.append(f"no further effect accepted; the best candidate, {h.description}, given "
+                         f"{len(effects)} effect(s): {why}")
+            break
+        new = []
+        for k, (x, t, d) in enumerate(zip(base + [h], th, sd)):
+            old = effects[k] if k < len(effects) else None
+            new.append(Finding(x.kind, x.station, x.element, float(t), x.unit, float(d),
+                               rss_new / s2 + len(th) * math.log(N),
+                               old.delta_chi2 if old is not None else float(dchi), x.description, True, False,
+                               None if (x.gain is not None or x.added) else x.nominal + float(t), x))
+        effects, thetas = new, list(th)
+        quality = quality_of(effects, thetas)
+    return effects, quality
 
 
 def _data_sets(rec, allf, chans, vchans):
@@ -336,23 +509,34 @@ def _refit_best(findings, refit, model_text, path, eng, fit, s2, N, rss0, thresh
     return notes
 
 
-def _decide(findings, none, threshold, N, rec, fit, eng, notes):
+def _decide(findings, none, threshold, N, rec, fit, eng, notes, held, s2):
     """The verdict (the best significant hypothesis, or none), those it cannot be told from, and the
-    sensor station that would separate them; notes are appended to ``notes``."""
-    best = next(f for f in findings if f.kind != "none")
+    sensor station that would separate them; notes are appended to ``notes``.
+
+    Among hypotheses the fitted data cannot tell apart, the held-out data decide when they can (one
+    fits them better by more than chi2_1(0.95) noise units): e.g. a sensor's gain and the scale of its
+    one fitted file are the same on the fitted data, not on other files of that sensor."""
+    best = next((f for f in findings if f.kind != "none" and not f.at_bound),
+                next(f for f in findings if f.kind != "none"))
     verdict = best if best.significant else none
     if verdict is none:
         if best.delta_chi2 > 0:
             notes.append(f"best hypothesis ({best.description}) improves the fit by delta chi2 = "
                          f"{best.delta_chi2:.1f}, below the threshold {threshold:.1f}")
         return verdict, [], None
+    tie = float(sst.chi2.isf(0.05, 1))
     ambiguous = [f for f in findings if f is not verdict and f.kind != "none" and f.significant
-                 and (f.score - verdict.score) < float(sst.chi2.isf(0.05, 1))]
+                 and (f.score - verdict.score) < tie]
+    if ambiguous:
+        held_rss = {id(f): _rss_of(Compound(rec, held, [f.hypothesis]).responses([f.value]), held.meas)
+                    for f in [verdict] + ambiguous}
+        alt = min(ambiguous, key=lambda f: held_rss[id(f)])
+        if (held_rss[id(verdict)] - held_rss[id(alt)]) / s2 > tie:
+            notes.append(f"{alt.description} and {verdict.description} fit the fitted data equally; the "
+                         f"held-out data prefer {alt.description}")
+            ambiguous = [verdict] + [f for f in ambiguous if f is not alt]
+            verdict = alt
     sensor = _separating_station(rec, fit, [verdict] + ambiguous, eng) if ambiguous else None
-    left = verdict.score - math.log(N)
-    if left > 2 * N + 6 * math.sqrt(2 * N):
-        notes.append(f"after the best hypothesis the residual is still {math.sqrt(left / N):.2g} "
-                     f"times the noise: part of the misfit lies beyond the hypotheses tested")
     return verdict, ambiguous, sensor
 
 

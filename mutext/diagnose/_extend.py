@@ -57,8 +57,8 @@ def extended_model_text(model_text: str, finding: Finding, model) -> str:
     lay = model.layout
     if h is None or finding.kind == "none":
         return model_text
-    if finding.kind == "sensor_gain":
-        return header + "# (a sensor calibration: the model itself is unchanged)\n" + model_text
+    if finding.kind in ("sensor_gain", "channel_scale", "sensor_delay"):
+        return header + "# (a correction of the measurement: the model itself is unchanged)\n" + model_text
     if lay.kind == "lumped":
         names = lay.node_names
         if h.added:
@@ -96,7 +96,11 @@ def extended_model_text(model_text: str, finding: Finding, model) -> str:
 
 
 def write_model(result: Diagnosis, out_dir) -> str | None:
-    """Write the extended model to ``out_dir/model_extended.toml`` (copying a station table it names)."""
+    """Write the extended model to ``out_dir/model_extended.toml`` (copying a station table it names).
+
+    Only a confirmed fix (:attr:`Diagnosis.confirmed`: explained, and better on held-out data) gets that
+    name; any other extended model is written as ``model_extended_NOT_CONFIRMED.toml`` with the
+    diagnosis's status in its first lines."""
     if result.extended_model_text is None:
         return None
     import shutil
@@ -112,7 +116,13 @@ def write_model(result: Diagnosis, out_dir) -> str | None:
         if os.path.abspath(src) != os.path.abspath(dst):
             shutil.copyfile(src, dst)
         text = text.replace(f'"{table}"', f'"{os.path.basename(table)}"')
-    out = os.path.join(out_dir, "model_extended.toml")
+    if result.confirmed:
+        out = os.path.join(out_dir, "model_extended.toml")
+    else:
+        # not a fix: the file says so in its name and its first lines
+        out = os.path.join(out_dir, "model_extended_NOT_CONFIRMED.toml")
+        text = (f"# NOT A CONFIRMED FIX. Diagnosis status: {result.status}; held-out gain {result.gain:.3g}x.\n"
+                f"# {result.headline()}\n" + text)
     with open(out, "w", encoding="utf-8") as fh:
         fh.write(text)
     result.extended_model = out

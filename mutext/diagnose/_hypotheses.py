@@ -4,7 +4,6 @@ from __future__ import annotations
 import logging
 import math
 import os
-from dataclasses import dataclass, field
 
 import casadi as ca
 import numpy as np
@@ -13,72 +12,15 @@ from ..rotor.crack import Crack
 from ..rotor.elements import BearingElement, Damper, ParameterSet, PointMass, Spring
 from ..rotor.model import load_model
 from ._channels import _resolve
+from .faults import channel as _channel
+from .faults._base import Hypothesis
 
 log = logging.getLogger("mutext.diagnose")
 
 #: Kinds of finding (the ``kind`` field of :class:`~mutext.diagnose.Finding`).
-KINDS = ("stiffness", "mass", "damping", "crack", "bearing", "exciter_gain", "sensor_gain", "none")
+KINDS = ("stiffness", "mass", "damping", "crack", "bearing") + _channel.KINDS + ("none",)
 
 _ORDER = {"stiffness": 0, "damping": 1, "mass": 2}      # D(w) = S * (1, j w, -w^2)[order]
-
-
-@dataclass
-class Hypothesis:
-    """One candidate cause: a *kind* at a *location*, with a size to fit.
-
-    Attributes
-    ----------
-    kind : str
-        One of :data:`KINDS`.
-    station : int or None
-        1-based station (rotor) or mass index (lumped chain), as numbered in the model file.
-    element : str or None
-        The model element changed (``"k1"``, ``"bearing2"``) or the name of the added one.
-    description : str
-        Plain-language description, e.g. ``"grounded spring added at m2"``.
-    unit : str
-        Unit of the size (``N/m``, ``kg``, ``N s/m``, ``1`` for a depth ratio or a gain).
-    added : bool
-        True when the hypothesis adds an element (size 0 = no effect), False
-        when it changes an existing value (the size is the change).
-    lower, upper : float
-        Bounds of the size (SI).
-    scale : float
-        Typical size (for the scan and the reporting of relative sizes).
-    dofs : list of int
-        DOFs U touched (0-based).
-    pattern : ndarray
-        The real matrix S on U (structural hypotheses).
-    order : int
-        0 stiffness, 1 damping, 2 mass (D = S, j w S, -w^2 S).
-    gain : tuple or None
-        ``("sensor", out_dof)`` or ``("exciter", input column spec)`` for gain hypotheses.
-    parameter : str or None
-        Parameter of the *extended* model that holds the size (for the full fit).
-    nominal : float
-        Value of the existing parameter (changes) or 0 (added elements); the
-        new value is ``nominal + size`` (gains: ``nominal * size``).
-    """
-    kind: str
-    station: int | None
-    element: str | None
-    description: str
-    unit: str
-    added: bool
-    lower: float
-    upper: float
-    scale: float
-    dofs: list = field(default_factory=list)
-    pattern: np.ndarray | None = None
-    order: int = 0
-    gain: tuple | None = None
-    parameter: str | None = None
-    nominal: float = 0.0
-    crack: object = None          # callable depth -> dK on dofs (crack hypotheses)
-
-    @property
-    def label(self) -> str:
-        return f"{self.kind} at {self.station}" + (f" ({self.element})" if self.element else "")
 
 
 def _lumped_hypotheses(model) -> list[Hypothesis]:
@@ -162,22 +104,6 @@ def _rotor_hypotheses(model, stations=None) -> list[Hypothesis]:
     return out
 
 
-def _gain_hypotheses(model, channels) -> list[Hypothesis]:
-    out = []
-    seen_out, seen_in = set(), set()
-    for ch in channels:
-        if ch.out_dof not in seen_out:
-            seen_out.add(ch.out_dof)
-            out.append(Hypothesis("sensor_gain", ch.out_station, ch.out_name, f"gain of sensor {ch.out_name}",
-                                  "1", False, 0.2, 5.0, 1.0, gain=("sensor", ch.out_dof), nominal=1.0))
-        if ch.in_spec not in seen_in:
-            seen_in.add(ch.in_spec)
-            what = "exciter" if ch.in_spec[0] == "port" else "force input"
-            out.append(Hypothesis("exciter_gain", ch.in_station, ch.in_name, f"gain of {what} {ch.in_name}",
-                                  "1", False, 0.2, 5.0, 1.0, gain=("exciter", ch.in_spec), nominal=1.0))
-    return out
-
-
 def hypotheses(model, frfs=None, *, stations=None) -> list[Hypothesis]:
     """The hypotheses :func:`diagnose` tests on ``model`` (given the measured channels ``frfs``)."""
     if isinstance(model, (str, os.PathLike)):
@@ -188,7 +114,7 @@ def hypotheses(model, frfs=None, *, stations=None) -> list[Hypothesis]:
         hyps += _crack_hypotheses(model, stations)
     if frfs is not None:
         chans, _ = _resolve(model, list(frfs), "FRF")
-        hyps += _gain_hypotheses(model, chans)
+        hyps += _channel.candidates(model, chans)
     return hyps
 
 

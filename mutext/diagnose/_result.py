@@ -16,7 +16,8 @@ class Finding:
     added element (SI), the depth ratio of a crack, or the factor of a gain.
     ``std`` its standard uncertainty; ``score`` the information criterion
     (lower is better); ``delta_chi2`` the improvement over *none*;
-    ``significant`` whether it passes the false-alarm test.
+    ``significant`` whether it passes the false-alarm test (never when the size
+    sits at a bound of its range: ``at_bound``).
     """
     kind: str
     station: int | None
@@ -31,21 +32,55 @@ class Finding:
     refit: bool = False
     new_value: float | None = None
     hypothesis: Hypothesis | None = field(default=None, repr=False)
+    at_bound: bool = False
 
     def as_dict(self) -> dict:
         return {"kind": self.kind, "station": self.station, "element": self.element, "value": self.value,
                 "unit": self.unit, "std": self.std, "score": self.score, "delta_chi2": self.delta_chi2,
                 "description": self.description, "significant": self.significant, "refit": self.refit,
-                "new_value": self.new_value}
+                "new_value": self.new_value, "at_bound": self.at_bound}
 
     def sentence(self) -> str:
         if self.kind == "none":
             return "no effect beyond the noise"
-        if self.unit == "1" and self.kind.endswith("gain"):
-            return f"{self.description}: x{self.value:.4g} +/- {self.std:.2g}"
+        bound = " (at the bound of its range)" if self.at_bound else ""
+        slip = _unit_slip(self.value, self.std) if self.kind in FACTOR_KINDS else ""
+        return f"{self.description}: {self.size_text()}{slip}{bound}"
+
+    def size_text(self, std: bool = True) -> str:
+        """The size with its unit (a factor as x1.05, a crack as a/D, a delay in ms)."""
+        if self.kind == "none":
+            return "-"
+        if self.kind in FACTOR_KINDS:
+            return f"x{self.value:.4g}" + (f" +/- {self.std:.2g}" if std else "")
         if self.kind == "crack":
-            return f"{self.description}: depth ratio a/D = {self.value:.4g} +/- {self.std:.2g}"
-        return f"{self.description}: {self.value:+.4g} +/- {self.std:.2g} {self.unit}"
+            return f"a/D {self.value:.4g}" + (f" +/- {self.std:.2g}" if std else "")
+        if self.kind == "sensor_delay":
+            return f"{1e3 * self.value:+.4g}" + (f" +/- {1e3 * self.std:.2g}" if std else "") + " ms"
+        return f"{self.value:+.4g}" + (f" +/- {self.std:.2g}" if std else "") + f" {self.unit}"
+
+
+#: Kinds whose size is a factor on the measured channels.
+FACTOR_KINDS = ("sensor_gain", "exciter_gain", "channel_scale")
+
+
+#: Factors (data over model) a channel is off by when a unit is mistaken, and the likely mistake.
+UNIT_SLIPS = ((1e6, "micro-units read as base units, e.g. um as m"),
+              (1e3, "milli-units read as base units, e.g. mm as m"),
+              (1e-3, "base units read as milli-units"), (1e-6, "base units read as micro-units"),
+              (25.4, "millimetres read as inches"), (1 / 25.4, "inches read as millimetres"),
+              (0.0254, "metres read as inches"), (1 / 0.0254, "inches read as metres"),
+              (9.80665, "m/s^2 read as g"), (1 / 9.80665, "g read as m/s^2"),
+              (4.4482216152605, "a force in lbf read as N"), (1 / 4.4482216152605, "a force in N read as lbf"),
+              (-1.0, "polarity reversed"))
+
+
+def _unit_slip(g: float, std: float) -> str:
+    """Names a gain that is a unit mistake (within 2 % or 3 std of a known factor)."""
+    for f, what in UNIT_SLIPS:
+        if abs(g - f) <= max(0.02 * abs(f), 3 * std):
+            return f" -- a unit slip? ({what})"
+    return ""
 
 
 @dataclass
@@ -121,10 +156,57 @@ class Diagnosis:
     mbi: dict | None = None
     sidebands: dict | None = None   # sideband evidence when the data were taken at speed (rotors)
     breathing: dict | None = None   # a crack that turns with the shaft, fitted when the sidebands call for it
+    status: str = "explained"       # "explained", "partly explained" or "not explained"
+    effects: list = field(default_factory=list)    # the accepted findings, in the order of selection
+    fit_quality: object = None      # _fit_quality.FitQuality of the final model
+    noise_reference: object = None  # _fit_quality.NoiseReference
+    unmatched: dict | None = None   # resonances without a partner: {"measured": [...], "model": [...]}
+
+    @property
+    def confirmed(self) -> bool:
+        """Whether the extended model is a fix: explained with an effect (the status requires that it
+        does better on held-out data, or, for a channel's own scale, no worse)."""
+        return self.status == "explained" and bool(self.effects)
+
+    def headline(self) -> str:
+        """The verdict in one line: the status first, then what was found."""
+        q = self.fit_quality
+        eff = "; ".join(f.sentence() for f in self.effects) or "no effect beyond the noise"
+        if self.status == "explained":
+            return f"EXPLAINED: {eff}"
+        left = "" if q is None else (f"the residual stays at {q.misfit:.3g} times the noise "
+                                     f"(at most {q.limit:.3g} if explained), {q.where()}")
+        nr = self.noise_reference
+        if nr is not None and not nr.linear:
+            left += ("; " if left else "") + "no linear time-invariant model describes the data at " + ", ".join(
+                f"{c} {a:.4g}-{b:.4g} Hz" for c, a, b, _ in nr.structured[:3]) + (
+                " (a response that depends on the amplitude, a time-varying system, or leakage)")
+        if self.status == "partly explained":
+            return (f"PARTLY EXPLAINED: {eff} helps (held-out gain {self.gain:.3g}x) but {left}; "
+                    f"uncertainties are inflated by the misfit, and the cause may lie beyond the hypotheses")
+        why = []
+        if self.effects and not self.gain > 1:
+            why.append(f"the best hypotheses ({eff}) make held-out data worse (gain {self.gain:.3g}x)")
+        elif self.effects:
+            why.append(f"the best hypotheses ({eff}) fit but are not confirmed")
+        else:
+            best = next((f for f in self.findings if f.kind != "none"), None)
+            if best is not None:
+                why.append(f"no hypothesis is significant (best: {best.description})")
+        if left:
+            why.append(left)
+        return "NOT EXPLAINED: " + "; ".join(why)
 
     def as_dict(self) -> dict:
         return {
             "model": self.model_source or self.model_name,
+            "status": self.status,
+            "headline": self.headline(),
+            "effects": [f.as_dict() for f in self.effects],
+            "confirmed": self.confirmed,
+            "fit_quality": None if self.fit_quality is None else self.fit_quality.as_dict(),
+            "noise_reference": None if self.noise_reference is None else self.noise_reference.as_dict(),
+            "unmatched_resonances": self.unmatched,
             "findings": [f.as_dict() for f in self.findings],
             "verdict": self.verdict.as_dict(),
             "noise": self.noise,
@@ -151,8 +233,16 @@ class Diagnosis:
 
     def report(self) -> str:
         """Plain-text report (what the command prints)."""
-        out = [f"model: {self.model_source or self.model_name}",
-               f"noise level estimated from the data: {100 * self.noise:.3g} % (relative, rms)", ""]
+        nr = self.noise_reference
+        how = "" if nr is None else {
+            "rational": f" by model-free rational fits, {nr.dof:.0f} degrees of freedom"
+                        + (f"; neighbouring lines correlated (r1 = {nr.r1:.2f}), counted as fewer" if nr.inflation > 1
+                           else ""),
+            "fourth differences": " by fourth differences along frequency (approximate)",
+            "given": " (given)"}[nr.method]
+        out = [f"verdict: {self.headline()}", "",
+               f"model: {self.model_source or self.model_name}",
+               f"noise level: {100 * self.noise:.3g} % (relative, rms){how}", ""]
         if self.resonances:
             # one row per model resonance: the channel that measures it most precisely
             best: dict = {}
@@ -175,18 +265,32 @@ class Diagnosis:
         out.append(f"hypotheses tested: {self.n_hypotheses} (accept if delta chi2 > {self.threshold:.1f}, "
                    f"false-alarm rate {100 * self.alpha:g} %; misfit left: after the hypothesis, in units of "
                    f"the noise's, about 1 when right)")
-        out.append(f"  {'rank':<4} {'kind':<12} {'station':>7} {'element':<14} {'size':>24} {'delta chi2':>11} "
-                   f"{'misfit left':>11}")
+        out.append(f"  {'rank':<4} {'kind':<13} {'station':>7} {'element':<14} {'size':>26} {'delta chi2':>11} "
+                   f"{'misfit left':>11} {'significant':>11}")
         for k, f in enumerate(self.findings[:8], start=1):
-            size = "-" if f.kind == "none" else (f"x{f.value:.4g}" if f.kind.endswith("gain")
-                                                 else f"a/D {f.value:.4g}" if f.kind == "crack"
-                                                 else f"{f.value:+.4g} {f.unit}")
-            sd = "" if f.kind == "none" else f" +/- {f.std:.2g}"
-            out.append(f"  {k:<4} {f.kind:<12} {str(f.station or '-'):>7} {str(f.element or '-'):<14} "
-                       f"{size + sd:>24} {f.delta_chi2:>11.1f} {self.misfit_left(f):>11.3g}")
+            sig = "yes" if f.significant else ("at bound" if f.at_bound else "")
+            out.append(f"  {k:<4} {f.kind:<13} {str(f.station or '-'):>7} {str(f.element or '-'):<14} "
+                       f"{f.size_text():>26} {f.delta_chi2:>11.1f} {self.misfit_left(f):>11.3g} {sig:>11}")
         out.append("")
-        out.append(f"verdict: {self.verdict.sentence()}")
-        if self.breathing:
+        q = self.fit_quality
+        if q is not None:
+            out.append(f"goodness of fit of the final model ({len(self.effects)} effect(s)): misfit "
+                       f"{q.misfit:.3g} x the noise, at most {q.limit:.3g} when explained "
+                       f"(p = {q.p_value:.2g}): " + ("at the noise" if q.at_noise else f"above the noise: {q.where()}"))
+        if self.unmatched and (self.unmatched.get("measured") or self.unmatched.get("model")):
+            um = self.unmatched
+            if um.get("measured"):
+                out.append("  measured resonances the model has no partner for: " + ", ".join(
+                    f"{x['freq_hz']:.4g} Hz ({x['channel']})" for x in um["measured"]))
+            if um.get("model"):
+                out.append("  model resonances outside the measured band: " + ", ".join(
+                    f"{x:.4g} Hz" for x in um["model"][:8]))
+        out.append(f"status: {self.status.upper()}")
+        for k, f in enumerate(self.effects, start=1):
+            out.append(f"  effect {k}: {f.sentence()}")
+        if not self.effects:
+            out.append("  no effect accepted")
+        if self.breathing and not self.breathing.get("rejected"):
             b = self.breathing
             out.append(f"  at speed: the crack turns with the shaft and breathes ({b['law']} law), a/D = "
                        f"{b['depth_ratio']:.4g} +/- {b['depth_std']:.2g} (details below; the time-invariant "
@@ -218,7 +322,8 @@ class Diagnosis:
         if self.breathing:
             b = self.breathing
             ti = b["time_invariant_crack"]
-            line = (f"crack turning with the shaft ({b['law']} breathing) in the {b['element']}: a/D = "
+            line = (("NOT SUPPORTED (" + b["rejected"] + "): " if b.get("rejected") else "")
+                    + f"crack turning with the shaft ({b['law']} breathing) in the {b['element']}: a/D = "
                     f"{b['depth_ratio']:.4g} +/- {b['depth_std']:.2g} (time-invariant crack there: "
                     f"a/D {ti['depth_ratio']:.4g}); misfit left {b['misfit_left']:.3g}")
             if b["delta_chi2_vs_time_invariant"] is not None:
@@ -231,7 +336,8 @@ class Diagnosis:
                        + f"; projection error of the reduced rotor {b['projection_error']:.1g}; {b['seconds']:.0f} s")
             out.append("  add to the model file: " + b["model_addition"].strip().replace("\n", "; "))
         if self.extended_model:
-            out.append(f"extended model: {self.extended_model}")
+            out.append(f"extended model: {self.extended_model}" + ("" if self.confirmed else
+                       " (NOT a confirmed fix: written under a name that says so)"))
         for n in self.notes:
             out.append(f"note: {n}")
         out.append(f"({self.seconds:.1f} s)")

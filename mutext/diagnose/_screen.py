@@ -8,6 +8,7 @@ import numpy as np
 
 from ._channels import _Chan
 from ._hypotheses import Hypothesis
+from .faults import channel as _channel
 
 
 class _Receptance:
@@ -91,16 +92,14 @@ class _Evaluator:
         return s[:, None, None] * h.pattern[None]
 
     def responses(self, theta: float, derivative: bool = False):
-        """Per channel ``H(theta)`` (and ``dH/dtheta`` when asked; for gains d/d ln g)."""
+        """Per channel ``H(theta)`` (and ``dH/dtheta`` when asked)."""
         h = self.hyp
         Hs, dHs = [], []
-        for ch, H0, piece in zip(self.data.chans, self.data.H0, self.pieces):
+        for k, (ch, H0, piece) in enumerate(zip(self.data.chans, self.data.H0, self.pieces)):
             if h.gain is not None:
-                hit = (h.gain[0] == "sensor" and ch.out_dof == h.gain[1]) or \
-                      (h.gain[0] == "exciter" and ch.in_spec == h.gain[1])
-                g = theta if hit else 1.0
-                Hs.append(H0 * g)
-                dHs.append(H0 / theta if hit else np.zeros_like(H0))
+                g, dg = _channel.factor(h, ch, self.data.freq_hz[k], theta)
+                Hs.append(H0 if g is None else H0 * g)
+                dHs.append(np.zeros_like(H0) if g is None else H0 * dg)
                 continue
             y, z, RUU, w = piece
             nU = len(h.dofs)
@@ -145,16 +144,9 @@ def _fit_size(ev: _Evaluator, n_scan: int = 25, gn_iter: int = 30):
         return v if math.isfinite(v) else math.inf
 
     if h.gain is not None:
-        # ln g enters linearly: closed form over the affected channels
-        r = []
-        for ch, H0, m in zip(ev.data.chans, ev.data.H0, meas):
-            hit = (h.gain[0] == "sensor" and ch.out_dof == h.gain[1]) or \
-                  (h.gain[0] == "exciter" and ch.in_spec == h.gain[1])
-            if hit:
-                r.append(np.log(H0 / m).real)
-        g = float(np.exp(-np.mean(np.concatenate(r))))
-        g = min(max(g, h.lower), h.upper)
-        return g, rss(g)
+        # the measurement chain enters the log residual linearly: closed form (both signs of a gain)
+        cands = _channel.fit(h, ev.data.chans, ev.data.H0, meas, ev.data.freq_hz)
+        return min(((t, rss(t)) for t in cands), key=lambda x: x[1])
 
     # scan: the null size, and sizes over four decades either side of the typical scale
     mags = h.scale * np.logspace(-3, 1, n_scan)
@@ -239,7 +231,7 @@ def _separating_station(rec: _Receptance, fit: _Data, cands: list, model) -> int
                               ch.speed)
                 Rb, _ = fit.columns(rec, k)
                 H0 = Rb[:, d]
-                data = _Data([probe], [idx], [H0], [H0], [b], None, {0: (Rb, rec.R[idx, d, :])})
+                data = _Data([probe], [idx], [H0], [H0], [b], [fit.freq_hz[k]], {0: (Rb, rec.R[idx, d, :])})
                 hs.append(_Evaluator(rec, data, h).responses(f.value)[0])
             resp.append(np.concatenate(hs))
         sep = min(float(np.sqrt(np.mean(np.abs(np.log(resp[i] / resp[j])) ** 2)))

@@ -35,7 +35,10 @@ resonance shape near the given natural frequency), so the model is only
 used to say where to look.
 
 A candidate closer to a mode than three half-power bandwidths is masked by
-the mode itself and reported as such, not tested.
+the mode itself and reported as such, not tested.  A sideband counts only
+with its mirror image: :math:`f_n - kF` found while :math:`f_n + kF` could be
+tested (in the band, not masked) and was not found is more likely a mode the
+model misplaces than a sideband, and is reported as *unpaired*.
 """
 from __future__ import annotations
 
@@ -61,6 +64,7 @@ class SidebandCandidate:
     snr: float = float("nan")
     found: bool = False
     masked: bool = False
+    unpaired: bool = False      # found, but its mirror f_n + kF testable and not found: not counted
 
     def to_dict(self) -> dict:
         return dict(self.__dict__)
@@ -100,7 +104,7 @@ class SidebandEvidence:
     detectable: float = float("nan")
 
     def found(self) -> list:
-        return [c for c in self.candidates if c.found]
+        return [c for c in self.candidates if c.found and not c.unpaired]
 
     def meaning(self) -> str:
         """What the verdict says about the rotor, in words."""
@@ -120,7 +124,7 @@ class SidebandEvidence:
         for c in self.candidates:
             if c.masked:
                 continue
-            mark = "FOUND" if c.found else "-"
+            mark = "FOUND, unpaired" if c.unpaired else "FOUND" if c.found else "-"
             lines.append(f"  mode {c.mode_hz:8.2f} Hz  k={c.k:+d}  at {c.freq_hz:8.2f} Hz  "
                          f"size {100 * c.relative_size:7.3f} %  dchi2 {c.delta_chi2:9.1f}  p {c.p_value:9.2e}  {mark}")
         return "\n".join(lines)
@@ -282,7 +286,14 @@ def sideband_evidence(frfs, natural_frequencies_hz, speed_hz: float, *, orders=(
         c.relative_size = float(max(sizes))
         c.snr = c.relative_size / noise
         c.found = bool(c.p_value < threshold)
-    found = sorted({abs(c.k) for c in cands if c.found})
+    # a sideband comes with its mirror image about the mode (f_n - kF and f_n + kF): one found alone,
+    # its partner testable and not found, is more likely a mode the model misplaces than a sideband
+    def paired(c):
+        partner = next((o for o in cands if o.mode_hz == c.mode_hz and o.k == -c.k), None)
+        return partner is None or partner.masked or partner.found
+    for c in cands:
+        c.unpaired = bool(c.found and not paired(c))
+    found = sorted({abs(c.k) for c in cands if c.found and not c.unpaired})
     verdict = ("once per revolution" if (1 in found or 3 in found) else
                "twice per revolution" if 2 in found else "none")
     n_win = max(8, int(round(2 * 2.5 / df)))

@@ -1,0 +1,197 @@
+r"""Several effects at once: exact responses under a set of hypotheses, their joint fit, forward selection.
+
+With accepted effects :math:`h_1,\dots,h_m` (sizes :math:`\theta_i`) the
+structural ones change the dynamic stiffness by
+:math:`\sum_i \theta_i D_i(\omega)` on the union :math:`U` of their degrees of
+freedom; the response follows exactly from the engineering model's receptance
+by the same Woodbury identity as one hypothesis
+(:mod:`mutext.diagnose`), with :math:`D` now the sum embedded in
+:math:`U`.  Gains multiply the channels they act on.
+
+Forward selection: given the accepted set :math:`A`, every other hypothesis
+:math:`h` is fitted with the sizes of :math:`A` held, and the best is refitted
+jointly with :math:`A`.  It is accepted only if
+
+* its improvement :math:`\Delta\chi^2 = (\mathrm{RSS}_A - \mathrm{RSS}_{A+h})/s^2`
+  passes the same Bonferroni threshold as the first effect, given the first
+  (the test of a nested model with one more parameter), and
+* it improves the held-out data too, by more than noise alone would
+  (:math:`\Delta\chi^2_{\mathrm{held}} > \chi^2_1(1-\alpha)`), and
+* no size of the joint fit sits at a bound of its range.
+
+Selection stops when the residual is at the noise (the lack-of-fit test of
+:mod:`mutext.diagnose._fit_quality`), when no candidate is accepted, or at
+:data:`MAX_EFFECTS`.
+"""
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import scipy.optimize as so
+
+from ._screen import _Data, _Receptance
+from .faults import channel as _channel
+
+#: Largest number of effects forward selection accepts.
+MAX_EFFECTS = 3
+
+
+class Compound:
+    """Responses of the channels of a data set under several hypotheses, exactly for any sizes."""
+
+    def __init__(self, rec: _Receptance, data: _Data, hyps: list):
+        self.hyps, self.data = list(hyps), data
+        struct = [h for h in self.hyps if h.gain is None]
+        U = sorted({d for h in struct for d in h.dofs})
+        self.U = U
+        nU = len(U)
+        # each structural hypothesis's pattern embedded in U once (D = sum theta s(w) P)
+        self.embed = {}
+        for h in struct:
+            p = [U.index(d) for d in h.dofs]
+            E = np.zeros((nU, len(p)))
+            E[p, range(len(p))] = 1.0
+            self.embed[id(h)] = E
+        self.pieces = []
+        for k, idx in enumerate(data.idx):
+            if not U:
+                self.pieces.append(None)
+                continue
+            Rb, Ro = data.columns(rec, k)
+            self.pieces.append((Rb[:, U], Ro[:, U], rec.R[np.ix_(idx, U, U)], rec.omega[idx]))
+
+    def _D(self, w, thetas):
+        nU = len(self.U)
+        D = np.zeros((w.size, nU, nU), complex)
+        for h, t in zip(self.hyps, thetas):
+            if h.gain is not None:
+                continue
+            E = self.embed[id(h)]
+            if h.crack is not None:
+                D += (E @ np.asarray(h.crack(t)) @ E.T)[None]
+            else:
+                s = (np.ones_like(w), 1j * w, -w * w)[h.order]
+                D += (t * s)[:, None, None] * (E @ h.pattern @ E.T)[None]
+        return D
+
+    def responses(self, thetas) -> list:
+        out = []
+        nU = len(self.U)
+        for k, (ch, H0, piece) in enumerate(zip(self.data.chans, self.data.H0, self.pieces)):
+            H = H0
+            if piece is not None:
+                y, z, RUU, w = piece
+                D = self._D(w, thetas)
+                u = np.linalg.solve(np.eye(nU)[None] + RUU @ D, y[:, :, None])
+                H = H0 - np.einsum("ku,ku->k", z, (D @ u)[:, :, 0])
+            for h, t in zip(self.hyps, thetas):
+                if h.gain is not None:
+                    g, _ = _channel.factor(h, ch, self.data.freq_hz[k], t)
+                    if g is not None:
+                        H = H * g
+            out.append(H)
+        return out
+
+
+def _rss_of(Hs, meas) -> float:
+    with np.errstate(all="ignore"):
+        r = np.concatenate([np.log(h / m) for h, m in zip(Hs, meas)])
+        v = float(np.sum(r.real ** 2 + r.imag ** 2))
+    return v if math.isfinite(v) else math.inf
+
+
+def _safe_rss(comp: Compound, thetas) -> float:
+    try:
+        return _rss_of(comp.responses(thetas), comp.data.meas)
+    except np.linalg.LinAlgError:
+        return math.inf
+
+
+def _bounds(h):
+    return h.lower, h.upper
+
+
+def _scan_grid(h, n=25):
+    if _channel.is_log_sized(h):
+        g = np.exp(np.linspace(math.log(h.lower), math.log(h.upper), 4 * n))
+        return sorted(list(-g) + list(g))
+    mags = h.scale * np.logspace(-3, 1, n)
+    grid = [0.0] + [m for m in mags if h.lower <= m <= h.upper] + [-m for m in mags if h.lower <= -m <= h.upper]
+    grid += [b for b in (h.lower, h.upper) if math.isfinite(b) and b not in grid]
+    return sorted(grid)
+
+
+def fit_one_given(rec, data, fixed: list, thetas: list, h):
+    """Size of ``h`` with the hypotheses ``fixed`` held at ``thetas``: (theta, rss)."""
+    comp = Compound(rec, data, fixed + [h])
+
+    def rss(t):
+        return _safe_rss(comp, list(thetas) + [t])
+    if h.gain is not None:
+        # the measurement chain is linear in the log residual: closed form on the responses given the others
+        base = Compound(rec, data, fixed).responses(thetas) if fixed else data.H0
+        return min(((t, rss(t)) for t in _channel.fit(h, data.chans, base, data.meas, data.freq_hz)),
+                   key=lambda x: x[1])
+    grid = _scan_grid(h, n=10)
+    vals = [rss(t) for t in grid]
+    j = int(np.argmin(vals))
+    t, best = grid[j], vals[j]
+    a, b = grid[max(j - 1, 0)], grid[min(j + 1, len(grid) - 1)]
+    if b > a:
+        res = so.minimize_scalar(rss, bounds=(a, b), method="bounded",
+                                 options={"xatol": 1e-6 * max(abs(t), h.scale), "maxiter": 40})
+        if res.fun < best:
+            t, best = float(res.x), float(res.fun)
+    return t, best
+
+
+def joint_fit(rec, data, hyps: list, start: list, s2: float, iters: int = 40):
+    """Levenberg-Marquardt fit of all sizes at once, in bounds: (thetas, rss, stds)."""
+    comp = Compound(rec, data, hyps)
+    meas = data.meas
+    # a gain keeps the sign it starts with (a reversed polarity stays reversed)
+    neg = [_channel.is_log_sized(h) and t < 0 for h, t in zip(hyps, start)]
+    lo = np.array([-h.upper if n else h.lower for h, n in zip(hyps, neg)], float)
+    hi = np.array([-h.lower if n else h.upper for h, n in zip(hyps, neg)], float)
+    scale = np.array([1.0 if _channel.is_log_sized(h) else max(h.scale, 1e-300) for h in hyps])
+
+    def resid(x):
+        th = np.clip(x * scale, lo, hi)
+        with np.errstate(all="ignore"):
+            r = np.concatenate([np.log(hh / m) for hh, m in zip(comp.responses(list(th)), meas)])
+        r = np.concatenate([r.real, r.imag])
+        return np.where(np.isfinite(r), r, 1e3)
+
+    x0 = np.clip(np.asarray(start, float), lo, hi) / scale
+    try:
+        sol = so.least_squares(resid, x0, bounds=(lo / scale, hi / scale), method="trf", x_scale="jac",
+                               max_nfev=iters * (len(hyps) + 1))
+        x = sol.x
+        J = sol.jac
+    except (ValueError, np.linalg.LinAlgError):
+        x = x0
+        J = None
+    th = np.clip(x * scale, lo, hi)
+    rss = _safe_rss(comp, list(th))
+    stds = [math.inf] * len(hyps)
+    if J is not None:
+        try:
+            cov = np.linalg.inv(J.T @ J) * s2
+            stds = [float(math.sqrt(max(cov[i, i], 0.0)) * scale[i]) for i in range(len(hyps))]
+        except np.linalg.LinAlgError:
+            pass
+    return [float(t) for t in th], rss, stds
+
+
+def at_bound(h, theta: float, rel: float = 1e-4) -> bool:
+    """Whether a fitted size sits at a bound of its range (an added element at 0 is no effect, not a bound)."""
+    log_sized = _channel.is_log_sized(h)
+    span = math.log(h.upper / h.lower) if log_sized else (h.upper - h.lower)
+    for b in (h.lower, h.upper):
+        if h.added and b == 0.0:
+            continue
+        d = abs(math.log(abs(theta) / b)) if log_sized else abs(theta - b)
+        if d <= rel * span:
+            return True
+    return False

@@ -1,0 +1,9 @@
+"""Kinds of effect, each in its own module: its candidates, what it changes, how it is fitted and described.
+
+:mod:`~mutext.diagnose.faults.channel`: effects on the measurement chain (a sensor's or an exciter's
+gain, a channel's scale or polarity -- unit slips --, a sensor's delay).  The structural kinds (springs,
+masses, dampers, bearings, cracks) are still defined in :mod:`mutext.diagnose._hypotheses`.
+"""
+from . import channel
+
+__all__ = ["channel"]

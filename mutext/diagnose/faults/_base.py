@@ -1,0 +1,67 @@
+"""What every kind of effect shares: the hypothesis, *kind at location*, with a size to fit."""
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+
+
+@dataclass
+class Hypothesis:
+    """One candidate cause: a *kind* at a *location*, with a size to fit.
+
+    Attributes
+    ----------
+    kind : str
+        One of :data:`KINDS`.
+    station : int or None
+        1-based station (rotor) or mass index (lumped chain), as numbered in the model file.
+    element : str or None
+        The model element changed (``"k1"``, ``"bearing2"``) or the name of the added one.
+    description : str
+        Plain-language description, e.g. ``"grounded spring added at m2"``.
+    unit : str
+        Unit of the size (``N/m``, ``kg``, ``N s/m``, ``1`` for a depth ratio or a gain).
+    added : bool
+        True when the hypothesis adds an element (size 0 = no effect), False
+        when it changes an existing value (the size is the change).
+    lower, upper : float
+        Bounds of the size (SI).
+    scale : float
+        Typical size (for the scan and the reporting of relative sizes).
+    dofs : list of int
+        DOFs U touched (0-based).
+    pattern : ndarray
+        The real matrix S on U (structural hypotheses).
+    order : int
+        0 stiffness, 1 damping, 2 mass (D = S, j w S, -w^2 S).
+    gain : tuple or None
+        Effects on the measurement chain (:mod:`mutext.diagnose.faults.channel`):
+        ``("sensor", out_dof)``, ``("exciter", input column spec)``, ``("channel", FRF)`` or
+        ``("delay", out_dof)``.
+    parameter : str or None
+        Parameter of the *extended* model that holds the size (for the full fit).
+    nominal : float
+        Value of the existing parameter (changes) or 0 (added elements); the
+        new value is ``nominal + size`` (gains: ``nominal * size``).
+    """
+    kind: str
+    station: int | None
+    element: str | None
+    description: str
+    unit: str
+    added: bool
+    lower: float
+    upper: float
+    scale: float
+    dofs: list = field(default_factory=list)
+    pattern: np.ndarray | None = None
+    order: int = 0
+    gain: tuple | None = None
+    parameter: str | None = None
+    nominal: float = 0.0
+    crack: object = None          # callable depth -> dK on dofs (crack hypotheses)
+
+    @property
+    def label(self) -> str:
+        return f"{self.kind} at {self.station}" + (f" ({self.element})" if self.element else "")
