@@ -71,7 +71,8 @@ COMMANDS = {
     "diagnose": ("mutext.commands.diagnose",
                  "what a model gets wrong against measured FRFs, its cause, the extended model and the gain"),
     "rig": ("mutext.commands.rig", "virtual rig: 'rig hide' writes a data set with a hidden effect"),
-    "frf": ("mutext.commands.frf", "FRF files: 'frf convert' between mutext's CSV and Universal File data set 58"),
+    "frf": ("mutext.commands.frf", "FRF files: 'frf convert' between mutext's CSV and Universal File data set 58, "
+                                   "'frf resonances' the model-free resonance table of measured FRFs"),
 }
 
 
@@ -98,6 +99,7 @@ def main(argv=None) -> int:
               "  diagnose --batch DIR [--jobs N]    every data set under DIR, summary.csv and index.html\n"
               "  rig hide --seed N --out DIR        a data set with a hidden effect to diagnose\n"
               "  frf convert IN OUT                 FRF file CSV <-> Universal File 58 (.csv, .uff, .unv)\n"
+              "  frf resonances FILE [...] [--json] resonances of measured FRFs: f_n, damping, channels\n"
               "  demo NAME [options]                run a demonstration (mutext demo --list)\n"
               "  grade EXERCISE SUBMISSION [--json] score a submission offline\n"
               "  grade EXERCISE DIR [--jobs N]      every submission in DIR: results per file, summary.csv\n")

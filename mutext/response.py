@@ -95,8 +95,11 @@ class FRF:
     output_quantity : {"displacement"}
     speed_hz : float or None
         Running speed during the measurement [Hz].
-    metadata : dict of str -> str
-        Any other header entries.
+    metadata : dict
+        Any other header entries (str -> str).  The file readers add
+        ``notes`` (a list of str: what the reader did that the user should
+        know, e.g. a 0 Hz line dropped) and ``conversion`` (a str: how the
+        file's values became m/N or m/A), see :mod:`mutext.rig`.
     source : pathlib.Path or None
         File the FRF was read from.
     input_direction, output_direction : {"x", "y"}

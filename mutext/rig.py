@@ -22,20 +22,48 @@ File format
 
 * Header lines ``# key: value`` come first.  Required keys:
   ``input_station`` (int), ``input_quantity`` (``force`` or ``current``),
-  ``input_unit`` (``N`` for a force, ``A`` for a current),
-  ``output_station`` (int), ``output_quantity`` (``displacement``),
-  ``output_unit`` (``m``, ``mm``, ``um`` or ``in``).  Optional:
-  ``speed_hz`` (float, running speed), ``input_direction`` and
+  ``input_unit`` (``N``, ``kN``, ``lbf``, ``lb`` for a force, ``A``, ``mA``
+  for a current), ``output_station`` (int), ``output_quantity``
+  (``displacement``, ``velocity`` or ``acceleration``), ``output_unit``
+  (``m``, ``mm``, ``um``, ``in`` ...; ``m/s``, ``mm/s``, ``in/s`` ...;
+  ``m/s^2``, ``m/s²``, ``g`` ... -- any label of
+  :func:`mutext.uff.parse_units` of that quantity, which may also hold the
+  whole ratio, e.g. ``(1/N)*(m/s²)``, if it agrees with ``input_unit``).
+  Optional: ``speed_hz`` (float, running speed), ``input_direction`` and
   ``output_direction`` (``x`` or ``y``, the plane of a rotor; default ``x``),
   ``input_name`` and ``output_name`` (the model's port names).  Any other ``# key: value`` is kept
   as metadata (strings).  Keys are case-sensitive and may appear once.
 * Then the CSV header line ``freq_hz,re,im`` and one row per frequency:
-  frequency in Hz (positive, strictly increasing) and the real and
-  imaginary parts of the response in ``output_unit`` per ``input_unit``
-  (e.g. um/A).  Blank lines are ignored.
+  frequency in Hz (strictly increasing) and the real and imaginary parts of
+  the response in ``output_unit`` per ``input_unit`` (e.g. um/A).  Blank
+  lines are ignored.  Rows at or below 0 Hz at the start (an analyzer's 0 Hz
+  line) are dropped with a note; a file with no row above 0 Hz is an error.
+* UTF-8 text; a file that is not UTF-8 (``µm`` or ``m/s²`` written in
+  Latin-1) is read as Latin-1, with a note.
 
-:func:`read_frf` converts the response to SI (m/N or m/A).  Every format error
-raises :class:`FRFFileError` naming the file, the line and the field.
+:func:`read_frf` converts the response to displacement per force or current
+in SI (m/N or m/A): units scaled, velocity divided by :math:`j\omega`,
+acceleration by :math:`-\omega^2` (:math:`\omega = 2\pi f`).  Every format
+error raises :class:`FRFFileError` naming the file, the line and the field; an
+unknown unit also says what to change (edit the label, or pass
+``units={label: label to read}``).
+
+What the readers tell about a file read, in :attr:`FRF.metadata`:
+
+* ``metadata["notes"]``: a list of str, present only when there is
+  something to note (lines at or below 0 Hz dropped, text read as Latin-1).
+  ``mutext frf convert`` and ``mutext frf resonances`` print them.
+* ``metadata["conversion"]``: a str, present when the values were changed:
+  what the file held and in what units, what it became, and each step (the
+  scale factor with the definitions of the units it comes from, e.g.
+  ``g = 9.80665 m/s^2``, ``in = 0.0254 m``, ``lbf = 4.4482216152605 N``;
+  the division by :math:`j\omega` or :math:`-\omega^2`).  A Universal File
+  also states it, changed or not, in ``metadata["uff_conversion"]``.
+* ``metadata["file_output_unit"]``, ``metadata["file_input_unit"]``: the
+  units labels as written.
+
+:func:`write_frf` writes none of these back (the file it writes holds SI
+values read as they stand).
 
 Universal File Format data set 58 (``.uff``/``.unv``, the export of modal-test
 software) is read too: :func:`read_frf` and :func:`read_frfs` hand such a file
@@ -72,7 +100,7 @@ import numpy as np
 
 from .errors import ModelError
 from .response import DIRECTIONS, FRF, INPUT_UNITS, OUTPUT_UNITS, FRFFileError, sweep_frequencies
-from .uff import is_uff_file, read_uff58
+from .uff import dropped_note, is_uff_file, motion_units, read_uff58, reference_units, relabel, units_hint
 
 __all__ = [
     "FRF", "FRFFileError", "Noise", "read_frf", "write_frf", "read_frfs", "measure",
@@ -96,6 +124,14 @@ _REQUIRED = ("input_station", "input_quantity", "input_unit",
              "output_station", "output_quantity", "output_unit")
 _OPTIONAL = ("speed_hz", "input_direction", "output_direction", "input_name", "output_name")
 _RESERVED = _REQUIRED + _OPTIONAL
+#: output quantities of a file -> units it may be given in (examples; any label of :func:`mutext.uff.parse_units`)
+_OUTPUT_QUANTITIES = {"displacement": "m, mm, um (µm), cm, in, mil, ft",
+                      "velocity": "m/s, mm/s, in/s",
+                      "acceleration": "m/s^2 (m/s², m/s2), mm/s^2, g, in/s^2"}
+_INPUT_UNIT_NAMES = {"force": "N, kN, lbf, lb", "current": "A, mA"}
+_SI_MOTION = {"displacement": "m", "velocity": "m/s", "acceleration": "m/s^2"}
+#: metadata set by the readers about the file read (not written back: the file written holds SI values)
+_PROVENANCE = ("file_output_unit", "file_input_unit", "conversion")
 
 
 # ----------------------------------------------------------------------------
@@ -120,7 +156,7 @@ def _parse_int(text: str, path, line: int, fld: str) -> int:
         raise FRFFileError(path, line, fld, f"{text.strip()!r} is not an integer") from None
 
 
-def read_frf(path, *, mapping=None) -> FRF:
+def read_frf(path, *, mapping=None, units=None) -> FRF:
     """Read one FRF file (format in the module docstring); the response is converted to SI.
 
     A Universal File (extension ``.uff`` or ``.unv``, or content starting with
@@ -134,25 +170,36 @@ def read_frf(path, *, mapping=None) -> FRF:
     mapping : dict of int -> int, optional
         For a Universal File only: UFF node -> model station
         (:func:`mutext.uff.read_uff58`; default station = node).
+    units : dict of str -> str, optional
+        Units labels to read differently, {label in the file: label to read}
+        (``output_unit``/``input_unit`` here; the units labels of a Universal
+        File).
 
     Returns
     -------
     FRF
         With ``source`` set to the path.  The units found in the file are
         kept in ``metadata['file_output_unit']`` and
-        ``metadata['file_input_unit']``.
+        ``metadata['file_input_unit']``; when the values were changed
+        (velocity or acceleration, units other than m per N or A), the
+        conversion in ``metadata['conversion']``; what the reader did that the
+        user should know (rows at or below 0 Hz dropped, text read as
+        Latin-1) in ``metadata['notes']``, a list of str (present only then).
 
     Raises
     ------
     FRFFileError
         Naming the file, the line (1-based) and the field for: a header line
         not of the form ``# key: value``, a repeated key, a missing required
-        key, an unknown quantity or unit, a station that is not an integer,
-        a missing or wrong CSV header, a row without three columns, a value
-        that is not a number or is NaN/infinite, a non-positive or
-        non-increasing frequency, and a file without data rows; for a
-        Universal File, naming the data set and field (:mod:`mutext.uff`), and
-        a file with more than one FRF.
+        key, an unknown quantity or unit (with what to change), a station
+        that is not an integer, a missing or wrong CSV header, a row without
+        three columns, a value that is not a number or is NaN/infinite, a
+        file with no frequency above 0 Hz, a non-positive frequency after the
+        first positive one, a non-increasing frequency, and a file without
+        data rows; for a Universal File, naming the data set and field
+        (:mod:`mutext.uff`), and a file with more than one FRF.  A file that
+        is not UTF-8 is read as Latin-1; if it still fails, the error says
+        both.
 
     Examples
     --------
@@ -171,7 +218,7 @@ def read_frf(path, *, mapping=None) -> FRF:
     """
     path = Path(path)
     if is_uff_file(path):
-        frfs = read_uff58(path, mapping=mapping)
+        frfs = read_uff58(path, mapping=mapping, units=units)
         if len(frfs) != 1:
             sets = ", ".join(f["uff_dataset"] for f in (h.metadata for h in frfs))
             raise FRFFileError(path, None, None, f"the Universal File holds {len(frfs)} FRFs (data sets {sets}); "
@@ -185,10 +232,32 @@ def read_frf(path, *, mapping=None) -> FRF:
         raise FRFFileError(path, None, None, "binary file (it contains NUL bytes); an FRF file is UTF-8 text")
     try:
         text = raw.decode("utf-8-sig")
+        latin = None
     except UnicodeDecodeError as exc:
-        line = raw[:exc.start].count(b"\n") + 1
-        raise FRFFileError(path, line, None, f"not UTF-8 text (byte 0x{raw[exc.start]:02x}); save the file "
-                                             f"as UTF-8") from None
+        # analyzers and spreadsheets write Latin-1 ('µm', 'm/s²'): read it as such, and say so
+        latin = (raw[:exc.start].count(b"\n") + 1, raw[exc.start])
+        text = raw.decode("latin-1")
+    try:
+        frf = _read_csv(path, text, {str(k).strip(): str(v) for k, v in dict(units or {}).items()})
+    except FRFFileError as err:
+        if latin is None:
+            raise
+        where = f"line {err.line}: " if err.line is not None else ""
+        raise FRFFileError(path, latin[0], err.field,
+                           f"not UTF-8 text (byte 0x{latin[1]:02x}), and read as Latin-1 it is no FRF file either: "
+                           f"{where}{err.problem}") from None
+    if latin is not None:
+        frf.metadata.setdefault("notes", []).insert(
+            0, f"not UTF-8 text (byte 0x{latin[1]:02x} on line {latin[0]}); read as Latin-1")
+    return frf
+
+
+def _units_error(path, ln, key, raw, what, why, allowed, example):
+    return FRFFileError(path, ln, key, f"unknown unit {raw!r} for a {what} ({why}); allowed: {allowed}; "
+                                       f"{units_hint(raw, example)}")
+
+
+def _read_csv(path, text: str, units: dict) -> FRF:
     lines = text.splitlines()
     header: dict[str, tuple[str, int]] = {}
     i = 0
@@ -234,18 +303,29 @@ def read_frf(path, *, mapping=None) -> FRF:
         raise FRFFileError(path, ln, "input_quantity", f"unknown quantity {in_q!r}; allowed: "
                                                        f"{', '.join(INPUT_UNITS)}")
     in_u, ln = header["input_unit"]
-    if in_u not in INPUT_UNITS[in_q]:
-        raise FRFFileError(path, ln, "input_unit", f"unknown unit {in_u!r} for a {in_q} input; "
-                                                   f"allowed: {', '.join(INPUT_UNITS[in_q])}")
+    try:
+        in_units = reference_units(relabel(in_u, units))
+        if ("force" if in_units.dims[2] else "current") != in_q:
+            raise ValueError(f"it is a {'force' if in_units.dims[2] else 'current'}")
+    except ValueError as exc:
+        raise _units_error(path, ln, "input_unit", in_u, f"{in_q} input", exc, _INPUT_UNIT_NAMES[in_q],
+                           "N" if in_q == "force" else "A") from None
     out_q, ln = header["output_quantity"]
-    if out_q not in OUTPUT_UNITS:
+    if out_q not in _OUTPUT_QUANTITIES:
         raise FRFFileError(path, ln, "output_quantity", f"unknown quantity {out_q!r}; allowed: "
-                                                        f"{', '.join(OUTPUT_UNITS)}")
+                                                        f"{', '.join(_OUTPUT_QUANTITIES)}")
     out_u, ln = header["output_unit"]
-    if out_u not in OUTPUT_UNITS[out_q]:
-        raise FRFFileError(path, ln, "output_unit", f"unknown unit {out_u!r} for a {out_q} "
-                                                    f"output; allowed: "
-                                                    f"{', '.join(OUTPUT_UNITS[out_q])}")
+    try:
+        out_units = motion_units(relabel(out_u, units))
+        if out_units.quantity != out_q:
+            raise ValueError(f"it is a {out_units.quantity}")
+        if out_units.reference is not None and (
+                out_units.reference != in_q
+                or not math.isclose(out_units.reference_factor * in_units.factor, 1.0, rel_tol=1e-9)):
+            raise ValueError(f"per {out_units.reference} in other units than the input_unit {in_u!r}")
+    except ValueError as exc:
+        raise _units_error(path, ln, "output_unit", out_u, f"{out_q} output", exc, _OUTPUT_QUANTITIES[out_q],
+                           _OUTPUT_QUANTITIES[out_q].split(",")[0]) from None
     speed = None
     if "speed_hz" in header:
         speed = _parse_float(header["speed_hz"][0], path, header["speed_hz"][1], "speed_hz")
@@ -257,7 +337,7 @@ def read_frf(path, *, mapping=None) -> FRF:
         dirs[key] = v
     port_names = {key: header[key][0] for key in ("input_name", "output_name") if key in header}
     # --- data rows
-    freqs, vals = [], []
+    freqs, vals, dropped = [], [], []
     names = CSV_HEADER.split(",")
     for j in range(i + 1, len(lines)):
         raw = lines[j].strip()
@@ -270,9 +350,20 @@ def read_frf(path, *, mapping=None) -> FRF:
         if len(parts) != 3:
             raise FRFFileError(path, j + 1, None, f"expected 3 comma-separated values "
                                                   f"({CSV_HEADER}), got {len(parts)}")
-        f, re_, im_ = (_parse_float(p, path, j + 1, n) for p, n in zip(parts, names))
+        f = _parse_float(parts[0], path, j + 1, "freq_hz")
+        if f <= 0 and not freqs:
+            # an analyzer's 0 Hz line (or lines below it) at the start: dropped, with a note
+            if dropped and f <= dropped[-1][0]:
+                raise FRFFileError(path, j + 1, "freq_hz", f"frequency {f} Hz is not greater than the previous one "
+                                                           f"({dropped[-1][0]} Hz on line {dropped[-1][1]})")
+            for p, n in zip(parts[1:], names[1:]):
+                _parse_float(p, path, j + 1, n, allow_nonfinite=True)
+            dropped.append((f, j + 1))
+            continue
+        re_, im_ = (_parse_float(p, path, j + 1, n) for p, n in zip(parts[1:], names[1:]))
         if f <= 0:
-            raise FRFFileError(path, j + 1, "freq_hz", f"frequency {f} Hz is not positive")
+            raise FRFFileError(path, j + 1, "freq_hz", f"frequency {f} Hz is not positive (only rows at the start "
+                                                       f"may be at or below 0 Hz; they are dropped)")
         if freqs and f <= freqs[-1][0]:
             raise FRFFileError(path, j + 1, "freq_hz",
                                f"frequency {f} Hz is not greater than the previous one "
@@ -281,14 +372,42 @@ def read_frf(path, *, mapping=None) -> FRF:
         freqs.append((f, j + 1))
         vals.append(complex(re_, im_))
     if not freqs:
+        if dropped:
+            raise FRFFileError(path, dropped[0][1], "freq_hz",
+                               f"frequency {dropped[0][0]} Hz is not positive, and no row above 0 Hz follows; an "
+                               f"FRF needs frequencies above 0 Hz")
         raise FRFFileError(path, csv_line, None, "no data rows after the CSV header")
-    scale = OUTPUT_UNITS[out_q][out_u] / INPUT_UNITS[in_q][in_u]
+    f_hz = np.array([f for f, _ in freqs])
+    G = np.array(vals)
+    factor = out_units.factor if out_units.reference is not None else out_units.factor / in_units.factor
+    defs = tuple(dict.fromkeys(out_units.definitions + in_units.definitions))
+    in_si = "N" if in_q == "force" else "A"
+    steps = []
+    G = G * factor
+    if factor != 1.0:
+        steps.append(f"scaled by {factor:.12g} to {_SI_MOTION[out_q]}/{in_si}"
+                     + (f" ({', '.join(defs)})" if defs else ""))
+    if out_q == "velocity":
+        G = G / (1j * 2 * np.pi * f_hz)
+        steps.append("divided by j*omega")
+    elif out_q == "acceleration":
+        G = G / (-(2 * np.pi * f_hz) ** 2)
+        steps.append("divided by -omega^2")
     meta = {k: v for k, (v, _) in header.items() if k not in _RESERVED}
     meta["file_output_unit"] = out_u
     meta["file_input_unit"] = in_u
-    return FRF(freq_hz=np.array([f for f, _ in freqs]), response=np.array(vals) * scale,
-               input_station=in_station, output_station=out_station, input_quantity=in_q,
-               output_quantity=out_q, speed_hz=speed, metadata=meta, source=path, **dirs, **port_names)
+    if steps:
+        read_as = "" if relabel(out_u, units) == out_u and relabel(in_u, units) == in_u else \
+            f", read as {relabel(out_u, units)} per {relabel(in_u, units)}"
+        conv = (f"{out_q} per {in_q} in the file ({out_u} per {in_u}{read_as}) -> displacement per {in_q} "
+                f"m/{in_si}: {', '.join(steps)}" + ("; omega = 2*pi*f [rad/s]" if out_q != "displacement" else ""))
+        meta["conversion"] = f"{meta['conversion']}; then {conv}" if "conversion" in meta else conv
+    if dropped:
+        lns = f"line {dropped[0][1]}" if len(dropped) == 1 else f"lines {dropped[0][1]}-{dropped[-1][1]}"
+        notes = [dropped_note([f for f, _ in dropped], lns)]
+        meta["notes"] = ([meta["notes"]] if isinstance(meta.get("notes"), str) else []) + notes
+    return FRF(freq_hz=f_hz, response=G, input_station=in_station, output_station=out_station, input_quantity=in_q,
+               output_quantity="displacement", speed_hz=speed, metadata=meta, source=path, **dirs, **port_names)
 
 
 def _breaks_line(text: str) -> bool:
@@ -306,7 +425,9 @@ def write_frf(path, frf: FRF, *, output_unit: str = "m") -> Path:
     frf : FRF
         Its stations must be set.  Metadata entries other than the reserved
         keys are written as ``# key: value`` lines (keys and values must be
-        single-line; keys may not contain ':').
+        single-line; keys may not contain ':'); what a reader noted about the
+        file it read (``file_output_unit``, ``file_input_unit``,
+        ``conversion``, a ``notes`` list) is not written.
     output_unit : {"m", "mm", "um", "in"}
         Unit of the written response (per N or per A).  Values are written
         with 17 significant digits, so reading back reproduces them to
@@ -345,9 +466,9 @@ def write_frf(path, frf: FRF, *, output_unit: str = "m") -> Path:
             lines.append(f"# {key}: {v.strip()}")
     written = {"input_station", "input_quantity", "input_unit", "output_station", "output_quantity",
                "output_unit", "speed_hz", "input_direction", "output_direction", "input_name", "output_name",
-               "file_output_unit", "file_input_unit"} | set(_RESERVED)
+               *_PROVENANCE} | set(_RESERVED)
     for k, v in frf.metadata.items():
-        if k in ("file_output_unit", "file_input_unit") or k in _RESERVED:
+        if k in _PROVENANCE or k in _RESERVED or (k == "notes" and isinstance(v, (list, tuple))):
             continue
         k, v = str(k), str(v)
         ks = k.strip()
@@ -372,7 +493,7 @@ def write_frf(path, frf: FRF, *, output_unit: str = "m") -> Path:
     return path
 
 
-def read_frfs(paths_or_glob, *, mapping=None) -> list[FRF]:
+def read_frfs(paths_or_glob, *, mapping=None, units=None) -> list[FRF]:
     """Read several FRF files.
 
     Parameters
@@ -384,6 +505,9 @@ def read_frfs(paths_or_glob, *, mapping=None) -> list[FRF]:
         (:func:`mutext.uff.read_uff58`).
     mapping : dict of int -> int, optional
         For Universal Files: UFF node -> model station.
+    units : dict of str -> str, optional
+        Units labels to read differently, {label in the file: label to read}
+        (:func:`read_frf`, :func:`mutext.uff.read_uff58`).
 
     Returns
     -------
@@ -404,9 +528,9 @@ def read_frfs(paths_or_glob, *, mapping=None) -> list[FRF]:
     out: list[FRF] = []
     for p in paths:
         if is_uff_file(p):
-            out.extend(read_uff58(p, mapping=mapping))
+            out.extend(read_uff58(p, mapping=mapping, units=units))
         else:
-            out.append(read_frf(p))
+            out.append(read_frf(p, units=units))
     return out
 
 
