@@ -37,7 +37,7 @@ from .errors import ModelError
 __all__ = ["SUMMARY_FIELDS", "check_jobs", "diagnose_batch", "find_data_sets", "run_parallel"]
 
 #: Columns of ``summary.csv``.
-SUMMARY_FIELDS = ("data_set", "status", "kind", "station", "element", "value", "unit", "std", "gain",
+SUMMARY_FIELDS = ("data_set", "status", "diagnosis", "effects", "kind", "station", "element", "value", "unit", "std", "gain",
                   "error_before", "error_after", "noise", "seconds", "key_kind", "key_station", "key_value",
                   "found", "error")
 
@@ -75,7 +75,8 @@ def _one(folder: str, out_name: str, mbi: bool) -> dict:
                            mbi=mbi)
             write_diagnosis(res, d / out_name)
         v = res.verdict
-        row.update(kind=v.kind, station=v.station, element=v.element, value=v.value, unit=v.unit, std=v.std,
+        row.update(diagnosis=res.status, effects="; ".join(f"{e.kind} at {e.station}" for e in res.effects)
+                   or "none", kind=v.kind, station=v.station, element=v.element, value=v.value, unit=v.unit, std=v.std,
                    gain=res.gain, error_before=res.error_before["rel"], error_after=res.error_after["rel"],
                    noise=res.noise)
     except Exception as exc:      # noqa: BLE001 - one bad data set must not stop the batch

@@ -110,14 +110,36 @@ def diagnosis_figures(result, outdir) -> list[str]:
     return paths
 
 
+def _quality_html(r: Diagnosis) -> str:
+    """The goodness of fit, the bands the final model leaves unexplained and the unmatched resonances."""
+    e = html.escape
+    q, out = r.fit_quality, []
+    if q is not None:
+        out.append(f"<p>Goodness of fit of the final model ({len(r.effects)} effect(s)): misfit {q.misfit:.3g} times "
+                   f"the noise, at most {q.limit:.3g} when explained (p = {q.p_value:.2g}).</p>")
+        if q.bands:
+            out.append("<p>Where it stays above the noise: " + e(q.where(6)) + ".</p>")
+    um = r.unmatched or {}
+    if um.get("measured"):
+        out.append("<p>Measured resonances the model has no partner for: " + e(", ".join(
+            f"{x['freq_hz']:.4g} Hz ({x['channel']})" for x in um["measured"])) + ".</p>")
+    if um.get("model"):
+        out.append("<p>Model resonances outside the measured band: " + e(", ".join(
+            f"{x:.4g} Hz" for x in um["model"][:8])) + ".</p>")
+    if r.extended_model and not r.confirmed:
+        out.append(f"<p><b>The extended model is not a confirmed fix</b> ({e(r.status)}, held-out gain "
+                   f"{r.gain:.3g}x).</p>")
+    return "".join(out)
+
+
 def _html(r: Diagnosis, figs) -> str:
     e = html.escape
     rows = "".join(
         f"<tr><td>{k}</td><td>{e(f.kind)}</td><td>{f.station or '-'}</td><td>{e(str(f.element or '-'))}</td>"
-        f"<td>{'' if f.kind == 'none' else f'{f.value:.5g} {e(f.unit)}'}</td>"
+        f"<td>{e(f.size_text(std=False))}</td>"
         f"<td>{'' if f.kind == 'none' else f'{f.std:.2g}'}</td><td>{f.delta_chi2:.1f}</td>"
         f"<td>{r.misfit_left(f):.3g}</td>"
-        f"<td>{'yes' if f.significant else ''}</td></tr>"
+        f"<td>{'yes' if f.significant else ('at bound' if f.at_bound else '')}</td></tr>"
         for k, f in enumerate(r.findings[:15], start=1))
     res = "".join(
         f"<tr><td>{e(x.channel)}</td><td>{x.measured_hz:.5g} &plusmn; {x.measured_hz_std:.2g}</td>"
@@ -140,7 +162,8 @@ table{{border-collapse:collapse}} tr:nth-child(even){{background:#f3f3f3}}</styl
 <h1>Diagnosis of {e(r.model_name)}</h1>
 <p>Model file: <code>{e(str(r.model_source))}</code>. Noise level estimated from the data:
 {100 * r.noise:.3g} % (relative).</p>
-<h2>Verdict</h2><p><b>{e(r.verdict.sentence())}</b></p>{amb}
+<h2>Verdict: {e(r.status)}</h2><p><b>{e(r.headline())}</b></p>{amb}
+{_quality_html(r)}
 <h2>What the model gets wrong</h2><ul>{summary}</ul>
 <table><tr><th>channel</th><th>measured Hz</th><th>model Hz</th><th>error</th><th>damping measured</th>
 <th>damping model</th></tr>{res}</table>

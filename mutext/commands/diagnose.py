@@ -39,12 +39,13 @@ def _batch(args, prog) -> int:
         import json
         print(json.dumps(rows, default=str))
         return 0
-    print(f"{'data set':<28} {'status':<7} {'verdict':<28} {'gain':>7} {'right':>6}")
+    print(f"{'data set':<28} {'run':<7} {'diagnosis':<17} {'effects':<36} {'gain':>7} {'right':>6}")
     for r in rows:
         name = os.path.relpath(r["data_set"], args.batch)
-        verdict = f"{r.get('kind', '')} at {r.get('station')}" if r["status"] == "ok" else r.get("error", "")[:60]
+        effects = r.get("effects", "") if r["status"] == "ok" else r.get("error", "")[:60]
         gain = f"{r['gain']:.3g}" if r.get("gain") is not None else ""
-        print(f"{name:<28} {r['status']:<7} {verdict:<28} {gain:>7} {str(r.get('found', '')):>6}")
+        print(f"{name:<28} {r['status']:<7} {r.get('diagnosis', ''):<17} {effects:<36} {gain:>7} "
+              f"{str(r.get('found', '')):>6}")
     keyed = [r for r in rows if "found" in r]
     failed = [r for r in rows if r["status"] != "ok"]
     print(f"{len(rows) - len(failed)} of {len(rows)} diagnosed" + (f", {len(failed)} failed" if failed else "")

@@ -68,6 +68,8 @@ def run(args) -> int:
               f"{100 * abs(err) / abs(key['value']):.2g} %)")
     elif right:
         print("found: nothing beyond the noise, rightly")
+    elif d.status != "explained":
+        print(f"not named: the diagnosis says {d.status} (the answer was {key['kind']} at {key['station']})")
     else:
         print(f"not found: the verdict is {v.kind} at {v.station}" +
               ("; the answer is among the hypotheses it cannot tell apart" if any(

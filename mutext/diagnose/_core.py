@@ -187,7 +187,13 @@ def _diagnose(model, frfs, validate, alpha, refit, noise, out_dir, progress, onl
     comps += [ChannelComparison(c.label, _src(c.frf, k + 1), c.frf.freq_hz, c.frf.response, held.H0[k],
                                 None if verdict is none else after_held[k], "validate")
               for k, c in enumerate(vchans)]
-    status = _status(effects, quality, gain)
+    with np.errstate(all="ignore"):
+        held_quality = fit_quality([np.log(h / m) for h, m in zip(after_held, held.meas)], held.freq_hz,
+                                   [c.label for c in held.chans], s2, 0, ref, alpha)
+    status = _status(effects, quality, gain, held_quality)
+    if quality.at_noise and not held_quality.at_noise:
+        notes.append(f"the fitted data are explained, the held-out data are not: misfit {held_quality.misfit:.3g} "
+                     f"times the noise (at most {held_quality.limit:.3g}), {held_quality.where()}")
     if effects and not quality.at_noise:
         infl = math.sqrt(max(quality.misfit, 1.0))
         for e in effects:
@@ -373,12 +379,13 @@ def _judge(f: Finding, N: int, threshold: float) -> None:
     f.significant = bool(f.delta_chi2 / left > threshold and not f.at_bound)
 
 
-def _status(effects, quality, gain) -> str:
-    """Explained: at the noise (and, with effects, better on held-out data); partly: effects that help on
-    held-out data, a residual above the noise; otherwise not explained."""
+def _status(effects, quality, gain, held_quality) -> str:
+    """Explained: the fitted and the held-out data at the noise (and, with effects, the held-out data better
+    than before); partly: effects that help on held-out data, a residual above the noise; otherwise not
+    explained."""
     # a channel's scale acts on its own file only: other files cannot confirm it, only not contradict it
     better = gain > 1 or (bool(effects) and all(e.kind == "channel_scale" for e in effects) and gain >= 1 - 1e-9)
-    if quality.at_noise:
+    if quality.at_noise and held_quality.at_noise:
         return "explained" if (not effects or better) else "not explained"
     return "partly explained" if (effects and better) else "not explained"
 

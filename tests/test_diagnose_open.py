@@ -1,0 +1,141 @@
+"""diagnose in an open world: the three-outcome verdict, several effects, the measurement chain, inputs that lie.
+
+The data come from ``benchmarks/_open_world.py``, a generator written apart from the package (numpy
+matrices read from the model file's TOML, its own noise; ``tests/test_open_world_generator.py`` checks
+it).  Effects the library names must be found (kind, place, size within the reported uncertainty);
+effects it does not name must never get "explained" with a wrong cause.
+"""
+import math
+import sys
+from dataclasses import replace
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "benchmarks"))
+from _open_world import make_case  # noqa: E402
+
+from mutext.diagnose import diagnose  # noqa: E402
+from mutext.errors import ModelError  # noqa: E402
+
+NOISE = 0.01
+
+
+def _run(case, **kw):
+    return diagnose(case.model_path, case.measured, validate=case.validate, **kw)
+
+
+@pytest.mark.parametrize("example,kind,seed", [
+    ("three_mass", "cubic_spring", 0),
+    ("three_mass", "tuned_absorber", 0),
+    ("three_mass", "nonadjacent_spring", 1),
+    ("three_mass", "wrong_model_extra_mass", 0),
+    ("three_mass", "roving_mass", 0),
+    ("four_story", "frequency_scale", 0),
+])
+def test_out_of_library_effects_are_never_explained_with_a_wrong_cause(example, kind, seed):
+    case = make_case(example, "out_of_library", kind, seed, NOISE)
+    d = _run(case)
+    assert d.status in ("partly explained", "not explained"), d.report()
+    assert not d.confirmed
+    assert d.headline().startswith(d.status.upper())
+    # the misfit is located: where in frequency and on which channel
+    assert d.fit_quality.misfit > d.fit_quality.limit or not d.noise_reference.linear
+    assert d.fit_quality.channels and all(m > 0 for _, m in d.fit_quality.channels)
+
+
+def test_a_nonlinear_spring_is_reported_as_data_no_linear_model_describes():
+    case = make_case("three_mass", "out_of_library", "cubic_spring", 1, NOISE)
+    d = _run(case)
+    assert not d.noise_reference.linear
+    assert "no linear time-invariant model" in d.headline()
+    lo, hi = min(a for _, a, _, _ in d.noise_reference.structured), max(b for _, _, b, _ in d.noise_reference.structured)
+    fn = sorted(np.sqrt(np.linalg.eigvals(np.linalg.solve(*_mk(case)))).real / (2 * np.pi))
+    assert any(lo - 0.5 <= f <= hi + 0.5 for f in fn)           # the structure sits at a resonance
+
+
+def _mk(case):
+    from _open_world import read_chain
+    M, C, K = read_chain(case.model_path).matrices()
+    return M, K
+
+
+@pytest.mark.parametrize("kinds,seed", [("mass+grounded_spring", 0), ("spring_change+damper_change", 1),
+                                        ("mass+sensor_gain", 2)])
+def test_two_simultaneous_effects_are_found_as_two(kinds, seed):
+    case = make_case("three_mass", "two_effect", kinds, seed, NOISE)
+    d = _run(case)
+    truth = {(e["kind"], e["station"]): e for e in case.key["effects"]}
+    assert d.status == "explained", d.report()
+    assert {(f.kind, f.station) for f in d.effects} == set(truth), d.report()
+    for f in d.effects:
+        t = truth[(f.kind, f.station)]
+        assert abs(f.value - t["value"]) <= 4 * f.std + 1e-9 * abs(t["value"]), (f.sentence(), t)
+    assert d.gain > 3 and d.confirmed
+
+
+def test_a_unit_slip_in_one_file_is_found_and_named():
+    case = make_case("four_story", "out_of_library", "unit_slip", 0, NOISE)
+    factor = case.key["details"]["value"]
+    d = _run(case)
+    assert d.status == "explained", d.report()
+    (f,) = d.effects
+    assert f.kind == "channel_scale"
+    assert abs(f.value - factor) <= 4 * f.std + 1e-6 * abs(factor)
+    assert "unit slip" in f.sentence()
+
+
+def test_a_sensor_delay_is_found_with_its_size():
+    case = make_case("three_mass", "out_of_library", "sensor_delay", 1, NOISE)
+    tau = case.key["details"]["value"]
+    d = _run(case)
+    assert d.status == "explained", d.report()
+    (f,) = d.effects
+    assert f.kind == "sensor_delay"
+    assert abs(f.value - tau) <= 4 * f.std, (f.sentence(), tau)
+
+
+def test_correlated_analyser_noise_does_not_make_a_right_model_wrong():
+    """Noise filtered as a Hann window correlates neighbouring lines (|r1| = 2/3): counted, not read as misfit."""
+    case = make_case("three_mass", "none", "none", 3, NOISE)
+    rng = np.random.default_rng(7)
+
+    def hann_noisy(frf, clean):
+        e = (rng.standard_normal(clean.size + 2) + 1j * rng.standard_normal(clean.size + 2)) / math.sqrt(2)
+        e = np.convolve(e, [-0.25, 0.5, -0.25], mode="valid") / math.sqrt(0.375)
+        return replace(frf, response=clean * (1 + NOISE * e))
+    meas = [hann_noisy(f, c) for f, c in zip(case.measured, case.clean)]
+    d = diagnose(case.model_path, meas, validate=case.validate)
+    assert d.noise_reference.inflation > 1.5 and d.noise_reference.r1 < -0.4
+    assert d.status == "explained" and not d.effects, d.report()
+
+
+def test_not_explained_result_writes_no_fix(tmp_path):
+    case = make_case("three_mass", "out_of_library", "wrong_model_extra_mass", 1, NOISE, workdir=tmp_path)
+    d = diagnose(case.model_path, case.measured, validate=case.validate, out_dir=tmp_path / "out")
+    assert d.status != "explained"
+    assert not (tmp_path / "out" / "model_extended.toml").exists()
+    if d.effects:
+        text = (tmp_path / "out" / "model_extended_NOT_CONFIRMED.toml").read_text()
+        assert text.startswith("# NOT A CONFIRMED FIX")
+    assert d.report().splitlines()[0].startswith("verdict: " + d.status.upper())
+
+
+def test_the_same_file_given_twice_is_refused():
+    case = make_case("three_mass", "none", "none", 0, NOISE)
+    twice = [case.measured[0], replace(case.measured[0])]
+    with pytest.raises(ModelError, match="same data"):
+        diagnose(case.model_path, twice)
+
+
+def test_a_size_at_the_bound_of_its_range_is_not_significant():
+    """An exciter gain of 8 lies beyond the calibration range (0.2-5): fitted at 5, flagged, never accepted."""
+    case = make_case("three_mass", "none", "none", 1, NOISE)
+    meas = [replace(f, response=8.0 * f.response) for f in case.measured]
+    val = [replace(f, response=8.0 * f.response) if f.input_station == 1 else f for f in case.validate]
+    d = diagnose(case.model_path, meas, validate=val)
+    gain = next(f for f in d.findings if f.kind == "exciter_gain")
+    assert gain.at_bound and not gain.significant and abs(gain.value) == pytest.approx(5.0)
+    assert "exciter_gain" not in {f.kind for f in d.effects}
+    assert d.status != "explained", d.report()       # the held-out files of that exciter say so
