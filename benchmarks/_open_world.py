@@ -38,20 +38,27 @@ Categories and kinds
     chain where every mass has one, e.g. ``three_mass``, the added damper is
     the same as a change of the existing one and the key names that
     element), ``sensor_gain`` (all channels of one sensor), ``exciter_gain``
-    (all channels of the measured exciter).  Sizes as in :mod:`mutext.hide`:
-    log-uniform, changes 3-30 % of the value (either sign), dampers 10-100 %
-    (a negative change at most 90 %), gains 2-20 % (either sign); an added
-    spring relative to the mass's diagonal stiffness, an added damper
-    relative to 10 % of :math:`\sqrt{K_{ii}M_{ii}}` (5 % of critical).
+    (all channels of the measured exciter), ``sensor_delay`` (one sensor's
+    channels times :math:`e^{-j\omega\tau}`, :math:`\tau` from 0.05-0.5 ms,
+    enlarged until detectable, at most the library's 10 ms; key: kind
+    ``sensor_delay`` at the sensor's mass, element the sensor, value
+    :math:`\tau` [s]) and ``unit_slip`` (one measured file scaled by 1e-3,
+    1e-6, 25.4 or -1, its validation file right; key: kind ``channel_scale``
+    at the file's output mass, element the channel ``"force->sensor"``, value
+    the factor :math:`H_{\mathrm{data}}/H_{\mathrm{model}}`).  Sizes as in
+    :mod:`mutext.hide`: log-uniform, changes 3-30 % of the value (either
+    sign), dampers 10-100 % (a negative change at most 90 %), gains 2-20 %
+    (either sign); an added spring relative to the mass's diagonal
+    stiffness, an added damper relative to 10 % of
+    :math:`\sqrt{K_{ii}M_{ii}}` (5 % of critical).
 ``two_effect`` (kind ``pair``, or ``A+B`` with two in-library kinds)
     Two in-library effects at different elements and different
-    (kind, station), each detectable alone.
+    (kind, station), each detectable alone; a file's scale and the gain of
+    its sensor are not drawn together when the sensor has only that measured
+    channel (the same factor on the measured data).
 ``out_of_library`` (:data:`OUT_OF_LIBRARY`)
     ``rayleigh_damping`` (:math:`C \to (1 + a) C`, :math:`a` from 0.25-0.5,
     or :math:`C + bK` with 0.5-2 % of critical added at the highest mode),
-    ``sensor_delay`` (one sensor's channels times :math:`e^{-j\omega\tau}`,
-    :math:`\tau` from 0.05-0.5 ms, enlarged until detectable),
-    ``unit_slip`` (one measured file scaled by 1e-3, 1e-6, 25.4 or -1),
     ``frequency_scale`` (every channel computed at :math:`f(1+\epsilon)`
     but labelled :math:`f`, :math:`|\epsilon|` from 0.1-0.3 %),
     ``roving_mass`` (each channel computed with an extra mass, 20 g to start,
@@ -85,7 +92,26 @@ noise.  A diagnosis that calls such data "explained" by one effect is then
 wrong beyond doubt.  Effects of fixed size (``unit_slip``,
 ``wrong_model_parameters``) are redrawn when they fail either rule.  The
 key records both measures (``change`` and ``single_fit["misfit"]``, in
-units of the noise) for every case.
+units of the noise) for every case.  The library fitted here
+(:func:`single_fit`) holds the diagnosis's local kinds: springs, dampers and
+masses changed, grounded springs and dampers added, sensor and exciter gains
+of either sign, a sensor's delay and one measured file's scale.  Kinds that
+change the whole structure at once (all damping scaled, the frequency axis,
+a mass moving with the sensor) are not fitted here: the out-of-library
+effects they describe stay out of library, and an explanation by them is
+judged by what it claims (below).
+
+Equivalent explanations
+-----------------------
+Several library effects together may describe an out-of-library effect
+exactly: :math:`C \to (1 + a) C` on a chain of discrete dampers is every
+damper changed by the fraction :math:`a`, a stiffness loss every spring
+changed by -8 %.  An explanation is therefore judged by the system it
+claims: :func:`claimed_data` applies its effects to this module's matrices
+and measurement chain, :func:`equivalence_error` compares the noise-free
+responses with the true ones on the validation channels and the measured
+files; below :data:`EQUIVALENT` (1/3) times the noise it is an equivalent
+description, not a wrong cause.
 
 Example
 -------
@@ -112,16 +138,15 @@ from mutext.rig import FRF
 __all__ = ["make_case", "Case", "Chain", "read_chain", "write_chain", "solve_response", "band_grid",
            "channels", "add_noise", "with_absorber", "cubic_response", "single_fit", "rms_log_change",
            "example_path", "EXAMPLES", "IN_LIBRARY", "OUT_OF_LIBRARY", "CATEGORIES", "DETECTABLE", "DISTINCT",
-           "NotDetectable"]
+           "EQUIVALENT", "NotDetectable", "claimed_data", "equivalence_error"]
 
 #: Shipped lumped chains: name -> file in mutext/data.
 EXAMPLES = {"three_mass": "three_mass.toml", "four_story": "four_story.toml"}
 
 IN_LIBRARY = ("spring_change", "grounded_spring", "mass", "damper_change", "grounded_damper", "sensor_gain",
-              "exciter_gain")
-OUT_OF_LIBRARY = ("rayleigh_damping", "sensor_delay", "unit_slip", "frequency_scale", "roving_mass",
-                  "cubic_spring", "tuned_absorber", "nonadjacent_spring", "wrong_model_parameters",
-                  "wrong_model_extra_mass", "stiffness_loss")
+              "exciter_gain", "sensor_delay", "unit_slip")
+OUT_OF_LIBRARY = ("rayleigh_damping", "frequency_scale", "roving_mass", "cubic_spring", "tuned_absorber",
+                  "nonadjacent_spring", "wrong_model_parameters", "wrong_model_extra_mass", "stiffness_loss")
 CATEGORIES = {"in_library": IN_LIBRARY, "two_effect": ("pair",), "out_of_library": OUT_OF_LIBRARY,
               "none": ("none",)}
 
@@ -133,8 +158,17 @@ DISTINCT = 1.0
 ENLARGE = 1.5
 #: force amplitude of the stepped sine on a cubic spring [N]
 CUBIC_FORCE = 1.0
-#: bounds of a gain factor in the library
+#: bounds of the magnitude of a sensor's or exciter's gain in the library (either sign)
 GAIN_BOUNDS = (0.2, 5.0)
+#: bounds of the magnitude of one measured file's scale in the library (either sign)
+SCALE_BOUNDS = (1e-7, 1e7)
+#: bounds of a sensor's delay in the library [s]
+DELAY_BOUNDS = (-0.01, 0.01)
+#: factors (data / model) of a unit slipped in one measured file
+UNIT_SLIPS = (1e-3, 1e-6, 25.4, -1.0)
+#: an explanation is equivalent to the truth when it reproduces the noise-free data within this many times the
+#: noise (rms |ln(H_claimed / H_true)|, :func:`equivalence_error`)
+EQUIVALENT = 1.0 / 3.0
 
 
 class NotDetectable(Exception):
@@ -151,13 +185,17 @@ class Case:
     change of the measured channels / noise), ``single_fit`` (best single library hypothesis on the
     noise-free data: ``kind, station, element, value, misfit`` with misfit / noise; None for ``none``),
     ``data_model`` (the file of the system measured when it differs from ``model_path``).
-    ``clean``: the noise-free responses of the measured channels (arrays, for checks).
+    ``clean``, ``clean_validate``: the noise-free responses of the measured and the validation channels
+    (arrays, for checks and for :func:`equivalence_error`); ``channels``: ``(measured, validate)`` as lists of
+    ``(force, sensor)`` names (:func:`channels`).
     """
     model_path: str
     measured: list
     validate: list
     key: dict = field(default_factory=dict)
     clean: list = field(default_factory=list, repr=False)
+    clean_validate: list = field(default_factory=list, repr=False)
+    channels: tuple = field(default=((), ()), repr=False)
 
 
 def example_path(name: str) -> str:
@@ -395,8 +433,10 @@ def _spring_between(K, between) -> float:
 
 def _library(chain: Chain, meas_ch):
     """Single hypotheses of the diagnosis's library on a chain, each ``(kind, station, element, matrix,
-    pattern, lo, hi, scale)`` (structural: matrix "M", "C" or "K") or ``(kind, station, element, "gain",
-    mask over the measured channels, lo, hi, 1)``."""
+    pattern, lo, hi, scale)`` (structural: matrix "M", "C" or "K"), ``(kind, station, element, "gain",
+    mask over the measured channels, lo, hi, 1)`` (a factor of either sign, its magnitude within
+    ``lo``-``hi``: a sensor's gain, an exciter's gain, one measured file's scale) or ``(kind, station,
+    element, "delay", mask, lo, hi, scale)`` (a sensor's delay)."""
     M, C, K = chain.matrices()
     n = len(chain.masses)
     hyps = []
@@ -421,9 +461,14 @@ def _library(chain: Chain, meas_ch):
     for s in dict.fromkeys(se for _, se in meas_ch):
         mask = np.array([se == s for _, se in meas_ch])
         hyps.append(("sensor_gain", chain.sensors[s] + 1, s, "gain", mask, *GAIN_BOUNDS, 1.0))
+        hyps.append(("sensor_delay", chain.sensors[s] + 1, s, "delay", mask, *DELAY_BOUNDS, 1e-4))
     for fo in dict.fromkeys(fo for fo, _ in meas_ch):
         mask = np.array([f == fo for f, _ in meas_ch])
         hyps.append(("exciter_gain", chain.forces[fo] + 1, fo, "gain", mask, *GAIN_BOUNDS, 1.0))
+    if len(meas_ch) > 1:            # with one channel a file's scale is the sensor's gain
+        for k, (fo, se) in enumerate(meas_ch):
+            mask = np.arange(len(meas_ch)) == k
+            hyps.append(("channel_scale", chain.sensors[se] + 1, f"{fo}->{se}", "gain", mask, *SCALE_BOUNDS, 1.0))
     return hyps
 
 
@@ -432,8 +477,10 @@ def single_fit(chain: Chain, meas_ch, f_hz, H_data) -> dict:
 
     Each hypothesis's size is fitted on the rms of :math:`|\\ln(H_{\\mathrm{model}}/H_{\\mathrm{data}})|`
     within the library's bounds (structural: a scan over decades and both signs, then a bounded 1-D
-    search around the best point; gains: in closed form).  Returns ``kind, station, element, value`` and
-    ``misfit`` (the rms left) of the best, and ``none`` (the rms with no hypothesis).
+    search around the best point; factors: the magnitude in closed form, both signs tried; delays: a scan
+    over the range and the closed form (the phase slope), then a bounded 1-D search).  Returns ``kind,
+    station, element, value`` and ``misfit`` (the rms left) of the best, and ``none`` (the rms with no
+    hypothesis).
     """
     M, C, K = chain.matrices()
     forces = {fo for fo, _ in meas_ch}
@@ -454,8 +501,10 @@ def single_fit(chain: Chain, meas_ch, f_hz, H_data) -> dict:
             H[rows[fo]] = x[:, outs[fo]].T
         return H
 
-    r0 = np.log(resp(Z0) / Hd)
+    ratio0 = resp(Z0) / Hd
+    r0 = np.log(ratio0)
     npts = r0.size
+    wk = np.broadcast_to(w, r0.shape)
 
     def rms(r):
         return float(np.sqrt(np.sum(np.abs(r) ** 2) / npts))
@@ -464,10 +513,28 @@ def single_fit(chain: Chain, meas_ch, f_hz, H_data) -> dict:
     for kind, station, element, mat, P, lo, hi, scale in _library(chain, meas_ch):
         if mat == "gain":
             lg = -float(np.mean(r0[P].real))
-            lg = min(max(lg, math.log(lo)), math.log(hi))
-            r = r0.copy()
-            r[P] += lg
-            val, mis = math.exp(lg), rms(r)
+            g = math.exp(min(max(lg, math.log(lo)), math.log(hi)))
+            val, mis = None, math.inf
+            for v in (g, -g):
+                r = r0.copy()
+                r[P] = np.log(ratio0[P] * v)
+                if rms(r) < mis:
+                    val, mis = v, rms(r)
+        elif mat == "delay":
+            def cost(tau, P=P):
+                r = r0.copy()
+                r[P] = np.log(ratio0[P] * np.exp(-1j * wk[P] * tau))
+                return rms(r)
+            tau0 = float(np.sum(wk[P] * r0[P].imag) / np.sum(wk[P] ** 2))
+            cand = sorted(set(list(np.linspace(lo, hi, 81)) + [0.0, min(max(tau0, lo), hi)]))
+            vals = [cost(v) for v in cand]
+            j = int(np.argmin(vals))
+            val, mis = cand[j], vals[j]
+            for a, b in ((cand[max(j - 1, 0)], cand[min(j + 1, len(cand) - 1)]),):
+                if b > a:
+                    res = minimize_scalar(cost, bounds=(a, b), method="bounded", options={"xatol": 1e-12})
+                    if res.fun < mis:
+                        val, mis = float(res.x), float(res.fun)
         else:
             D = fac[mat][:, None, None] * P[None]
 
@@ -500,20 +567,38 @@ def single_fit(chain: Chain, meas_ch, f_hz, H_data) -> dict:
 
 @dataclass
 class _State:
-    """A linear chain as measured: matrices (possibly with extra DOFs after the chain's), gains."""
+    """A linear chain as measured: matrices (possibly with extra DOFs after the chain's), the measurement
+    chain: gains of exciters (``gin``) and sensors (``gout``), delays of sensors [s] (``delay``), and the
+    scale of measured files (``scale``, ``{(force, sensor): factor}``: the measured file of that channel
+    only, not its validation file)."""
     M: np.ndarray
     C: np.ndarray
     K: np.ndarray
     gin: dict = field(default_factory=dict)
     gout: dict = field(default_factory=dict)
+    delay: dict = field(default_factory=dict)
+    scale: dict = field(default_factory=dict)
+    eps: float = 0.0                 # the structure's response taken at f (1 + eps), labelled f
+    sensor_mass: float = 0.0         # a mass at each channel's own output mass (moves with the sensor)
 
 
 def _linear(chain: Chain, st: _State):
     def data(chans, f, role="measured"):
         out = []
+        fs = np.asarray(f, float) * (1 + st.eps) if st.eps else f
         for fo, se in chans:
-            h = solve_response(st.M, st.C, st.K, chain.forces[fo], [chain.sensors[se]], f)[0]
-            out.append(h * st.gin.get(fo, 1.0) * st.gout.get(se, 1.0))
+            j = chain.sensors[se]
+            M = st.M
+            if st.sensor_mass:
+                M = M.copy()
+                M[j, j] += st.sensor_mass
+            h = solve_response(M, st.C, st.K, chain.forces[fo], [j], fs)[0]
+            h = h * st.gin.get(fo, 1.0) * st.gout.get(se, 1.0)
+            if st.delay.get(se, 0.0) != 0.0:
+                h = h * np.exp(-2j * np.pi * np.asarray(f, float) * st.delay[se])
+            if role == "measured":
+                h = h * st.scale.get((fo, se), 1.0)
+            out.append(h)
         return out
     return data
 
@@ -603,7 +688,10 @@ def _draw_in_library(chain: Chain, kind: str, rng, taken=()) -> _Effect:
         return _Effect(key, _sign(rng) * _logu(rng, 0.03, 0.3) * m0, 0.0, (-0.9 * m0, 10 * m0),
                        lambda st, v, P=unit_p(i): replace(st, M=st.M + v * P))
     if kind == "sensor_gain":
-        opts = [s for s in chain.sensors if free("sensor_gain", chain.sensors[s] + 1, s)]
+        meas_ch, _ = channels(chain)
+        alone = {s for s in chain.sensors if sum(x == s for _, x in meas_ch) == 1}
+        opts = [s for s in chain.sensors if free("sensor_gain", chain.sensors[s] + 1, s)
+                and not (s in alone and ("channel_scale", chain.sensors[s] + 1) in used_pairs)]
         if not opts:
             raise NotDetectable("no free sensor")
         s = opts[int(rng.integers(len(opts)))]
@@ -611,6 +699,35 @@ def _draw_in_library(chain: Chain, kind: str, rng, taken=()) -> _Effect:
                "description": f"gain of sensor {s}"}
         return _Effect(key, 1.0 + _sign(rng) * _logu(rng, 0.02, 0.2), 1.0, GAIN_BOUNDS,
                        lambda st, v, s=s: replace(st, gout={**st.gout, s: st.gout.get(s, 1.0) * v}))
+    if kind == "sensor_delay":
+        opts = [s for s in chain.sensors if free("sensor_delay", chain.sensors[s] + 1, s)]
+        if not opts:
+            raise NotDetectable("no free sensor")
+        s = opts[int(rng.integers(len(opts)))]
+        key = {"kind": "sensor_delay", "station": chain.sensors[s] + 1, "element": s, "unit": "s",
+               "description": f"delay of sensor {s}"}
+        return _Effect(key, _logu(rng, 5e-5, 5e-4), 0.0, (0.0, DELAY_BOUNDS[1]),
+                       lambda st, v, s=s: replace(st, delay={**st.delay, s: st.delay.get(s, 0.0) + v}))
+    if kind == "unit_slip":
+        meas_ch, _ = channels(chain)
+
+        def open_file(fo, se):
+            station = chain.sensors[se] + 1
+            # with one measured channel of its sensor, the file's scale is that sensor's gain on the measured
+            # data (only the validation files tell them apart): not drawn together
+            alone = sum(x == se for _, x in meas_ch) == 1
+            return free("channel_scale", station, f"{fo}->{se}") and not (alone and ("sensor_gain", station)
+                                                                          in used_pairs)
+        opts = [c for c in meas_ch if open_file(*c)]
+        if not opts:
+            raise NotDetectable("no free measured file")
+        fo, se = opts[int(rng.integers(len(opts)))]
+        factor = UNIT_SLIPS[int(rng.integers(len(UNIT_SLIPS)))]
+        key = {"kind": "channel_scale", "station": chain.sensors[se] + 1, "element": f"{fo}->{se}", "unit": "1",
+               "description": f"unit slip in the measured file {fo}->{se} (factor {factor:g}; its validation "
+                              f"file is right)"}
+        return _Effect(key, factor, 1.0, (factor, factor),
+                       lambda st, v, c=(fo, se): replace(st, scale={**st.scale, c: st.scale.get(c, 1.0) * v}))
     if kind == "exciter_gain":
         fo = list(chain.forces)[0]          # the exciter of the measured channels
         if not free("exciter_gain", chain.forces[fo] + 1, fo):
@@ -661,33 +778,6 @@ def _draw_open(chain: Chain, kind: str, rng, workdir: Path, tag: str):
         det = {"form": "C -> C + b K", "parameter": "b [s]"}
         return (det, b, 0.0, (0.0, 2 * 0.5 / wmax), lambda v: _linear(chain, replace(base, C=C + v * K)),
                 chain, None, False)
-    if kind == "sensor_delay":
-        s = list(chain.sensors)[int(rng.integers(len(chain.sensors)))]
-        lin = _linear(chain, base)
-
-        def data_of(tau, s=s):
-            def data(chans, f, role="measured"):
-                H = lin(chans, f, role)
-                return [h * np.exp(-2j * np.pi * np.asarray(f) * tau) if se == s else h
-                        for (fo, se), h in zip(chans, H)]
-            return data
-        det = {"sensor": s, "station": chain.sensors[s] + 1, "parameter": "tau [s]"}
-        return det, _logu(rng, 5e-5, 5e-4), 0.0, (0.0, 0.05), data_of, chain, None, False
-    if kind == "unit_slip":
-        k = int(rng.integers(len(meas_ch)))
-        factor = [1e-3, 1e-6, 25.4, -1.0][int(rng.integers(4))]
-        lin = _linear(chain, base)
-
-        def data_of(v, k=k):
-            def data(chans, f, role="measured"):
-                H = lin(chans, f, role)
-                if role == "measured":
-                    H = [h * v if j == k else h for j, h in enumerate(H)]
-                return H
-            return data
-        det = {"channel": f"{meas_ch[k][0]}->{meas_ch[k][1]}", "parameter": "factor",
-               "files": "measured only (one file written in another unit or polarity)"}
-        return det, factor, 1.0, (factor, factor), data_of, chain, None, True
     if kind == "frequency_scale":
         lin = _linear(chain, base)
 
@@ -796,6 +886,94 @@ def _draw_open(chain: Chain, kind: str, rng, workdir: Path, tag: str):
         det = {"form": "every spring times (1 - d)", "parameter": "d"}
         return det, 0.08, 0.0, (0.0, 0.6), lambda v: _linear(chain, replace(base, K=(1 - v) * K)), chain, None, False
     raise ValueError(f"unknown out-of-library kind {kind!r}; kinds: {', '.join(OUT_OF_LIBRARY)}")
+
+
+# ----------------------------------------------------------------------------------------------
+# an explanation judged by what it claims: the system it describes against the true one
+# ----------------------------------------------------------------------------------------------
+
+def claimed_data(chain: Chain, effects):
+    """The system an explanation describes: ``chain`` (the model handed to the diagnosis) with ``effects``
+    applied, as a data function ``(channels, f, role) -> responses``.
+
+    ``effects``: dicts (or objects) with ``kind, station, element, value`` as the library names them:
+    ``stiffness`` / ``damping`` (``element`` a spring or damper of the chain: its value changed by
+    ``value``; otherwise a grounded one added at mass ``station`` of size ``value``), ``mass`` (mass
+    ``element``, or the mass at ``station``, changed by ``value``), ``sensor_gain`` / ``exciter_gain``
+    (every channel of the sensor / force input ``element`` times ``value``), ``channel_scale`` (the measured
+    file ``element`` = ``"force->sensor"`` times ``value``; not its validation file), ``sensor_delay``
+    (every channel of sensor ``element`` times :math:`e^{-j\\omega\\tau}`, ``value`` = :math:`\\tau` [s]); kinds
+    of the whole structure: ``damping_scale`` (the chain's own damping times :math:`1 + a`, ``value`` =
+    :math:`a`; elements changed or added by other effects are not scaled), ``frequency_scale`` (the structure's
+    response at :math:`f(1 + \\epsilon)` labelled :math:`f`, ``value`` = :math:`\\epsilon`) and ``sensor_mass``
+    (a mass ``value`` [kg] at each channel's own output mass).
+    """
+    M, C, K = chain.matrices()
+    st = _State(M, C, K)
+    n = len(chain.masses)
+    get = (lambda e, k: e[k]) if all(isinstance(e, dict) for e in effects) else (lambda e, k: getattr(e, k))
+    for e in effects:
+        kind, station, element, v = get(e, "kind"), get(e, "station"), get(e, "element"), float(get(e, "value"))
+        if kind in ("stiffness", "damping"):
+            mat, els = ("K", chain.springs) if kind == "stiffness" else ("C", chain.dampers)
+            el = next((x for x in els if x["name"] == element), None)
+            if el is not None:
+                P = chain.pattern(el["between"])
+            else:                       # an added grounded element at the mass ``station``
+                P = np.zeros((n, n))
+                P[int(station) - 1, int(station) - 1] = 1.0
+            st = replace(st, **{mat: getattr(st, mat) + v * P})
+        elif kind == "mass":
+            i = chain.names.index(element) if element in chain.names else int(station) - 1
+            Mx = st.M.copy()
+            Mx[i, i] += v
+            st = replace(st, M=Mx)
+        elif kind == "sensor_gain":
+            s = element if element in chain.sensors else _port_at(chain.sensors, station)
+            st = replace(st, gout={**st.gout, s: st.gout.get(s, 1.0) * v})
+        elif kind == "exciter_gain":
+            fo = element if element in chain.forces else _port_at(chain.forces, station)
+            st = replace(st, gin={**st.gin, fo: st.gin.get(fo, 1.0) * v})
+        elif kind == "sensor_delay":
+            s = element if element in chain.sensors else _port_at(chain.sensors, station)
+            st = replace(st, delay={**st.delay, s: st.delay.get(s, 0.0) + v})
+        elif kind == "channel_scale":
+            fo, se = str(element).split("->")
+            st = replace(st, scale={**st.scale, (fo, se): st.scale.get((fo, se), 1.0) * v})
+        elif kind == "damping_scale":
+            st = replace(st, C=st.C + v * C)
+        elif kind == "frequency_scale":
+            st = replace(st, eps=st.eps + v)
+        elif kind == "sensor_mass":
+            st = replace(st, sensor_mass=st.sensor_mass + v)
+        else:
+            raise ValueError(f"claimed_data: no physics here for an effect of kind {kind!r}")
+    return _linear(chain, st)
+
+
+def _port_at(ports: dict, station) -> str:
+    return next(p for p, i in ports.items() if i + 1 == int(station))
+
+
+def equivalence_error(case: Case, effects) -> dict:
+    r"""How far the system an explanation claims is from the true one, on noise-free responses.
+
+    The model handed to the diagnosis (``case.model_path``) with ``effects`` applied (:func:`claimed_data`)
+    against the true noise-free data: rms over points of :math:`|\ln(H_{\mathrm{claimed}}/H_{\mathrm{true}})|`
+    on the validation channels (``validate``: other frequencies, other exciters) and on the measured files
+    (``measured``: where an effect on one file, a channel's scale, shows), and ``error``, the larger.
+    An explanation with ``error`` below :data:`EQUIVALENT` times the noise reproduces the true system well
+    below the noise on every channel: an equivalent description of the data (e.g. every damper changed by
+    the same fraction for proportional damping :math:`C \to (1 + a) C`), not a wrong cause.
+    """
+    chain = read_chain(case.model_path)
+    data = claimed_data(chain, effects)
+    meas_ch, val_ch = case.channels
+    f_meas, f_val = case.measured[0].freq_hz, case.validate[0].freq_hz
+    out = {"measured": rms_log_change(data(list(meas_ch), f_meas, "measured"), case.clean),
+           "validate": rms_log_change(data(list(val_ch), f_val, "validate"), case.clean_validate)}
+    out["error"] = max(out["measured"], out["validate"])
+    return out
 
 
 # ----------------------------------------------------------------------------------------------
@@ -947,4 +1125,6 @@ def make_case(example: str, category: str, kind: str, seed: int, noise: float, w
         key["single_fit"] = {**fit, "misfit": fit["misfit"] / noise, "none": fit["none"] / noise}
     measured = _frfs(chain, data, meas_ch, f, noise, noise_rng, "measured")
     validate = _frfs(chain, data, val_ch, f_val, noise, noise_rng, "validate")
-    return Case(str(model_path), measured, validate, key, [np.asarray(h) for h in Hm])
+    Hv = data(val_ch, f_val, "validate")
+    return Case(str(model_path), measured, validate, key, [np.asarray(h) for h in Hm],
+                [np.asarray(h) for h in Hv], (list(meas_ch), list(val_ch)))

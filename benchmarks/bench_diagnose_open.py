@@ -8,15 +8,15 @@ lumped chains ``three_mass`` and ``four_story``:
 
 * ``in_library``: one effect of every in-library kind (spring changed,
   grounded spring added, mass changed, damper changed, grounded damper added,
-  sensor gain, exciter gain);
+  sensor gain, exciter gain, sensor delay, a unit slipped in one measured
+  file: the library's ``channel_scale`` of that file);
 * ``two_effect``: two in-library effects at different elements, each
   detectable alone;
 * ``out_of_library``: effects no single hypothesis describes (proportional
-  damping, a sensor delay, a unit slip in one file, a scaled frequency axis,
-  a roving sensor mass, a cubic spring, a tuned-mass absorber, a spring
-  between non-adjacent masses, a wrong model, a distributed stiffness loss),
-  each enlarged until the best single library hypothesis leaves at least the
-  noise's own misfit;
+  damping, a scaled frequency axis, a roving sensor mass, a cubic spring, a
+  tuned-mass absorber, a spring between non-adjacent masses, a wrong model,
+  a distributed stiffness loss), each enlarged until the best single library
+  hypothesis leaves at least the noise's own misfit;
 * ``none``: no effect.
 
 Every case is diagnosed with ``mutext.diagnose.diagnose(case.model_path,
@@ -34,40 +34,60 @@ versions without it:
   unless its kind is "none"); a finding has ``kind``, ``station``,
   ``element``, ``value``, ``std``, ``unit`` and ``at_bound`` (fallback False).
 
+An explanation is judged by what it claims, not by its labels: the
+generator applies the claimed effects (``d.effects``: kind, station, element,
+value) to its own matrices and measurement chain of the model handed over
+(``_open_world.claimed_data``) and compares the noise-free responses with the
+true noise-free data (``_open_world.equivalence_error``): the rms of
+:math:`|\ln(H_{\mathrm{claimed}}/H_{\mathrm{true}})|` over the validation
+channels and over the measured files (where a file's own scale shows), the
+larger of the two.  Below ``noise / 3`` (:data:`_open_world.EQUIVALENT`) the
+claimed system reproduces the true one to a third of the noise at every point
+(its added mean-square error at most a ninth of the noise's, on channels and
+frequencies never fitted too): an equivalent description of the data, not a
+wrong cause.  Some out-of-library effects are exactly such combinations on
+some chains: proportional damping :math:`C \to (1 + a) C` on a chain of
+discrete dampers is every damper changed by the fraction a, a distributed
+stiffness loss every spring changed by -8 %.
+
 Per case:
 
 * **right**: status "explained" and the (kind, station) pairs of
   ``d.effects`` equal those of the key, as a multiset (a two-effect case
   needs both, found as two effects); for a "none" case: "explained" with no
   effect.  Out-of-library cases have no right answer of this form ("-").
-  **right but flagged**: the right effects with status "partly explained"
+* **right (equivalent)**: status "explained", not right as above, and the
+  claimed system equivalent to the true one (in-library, two-effect and
+  out-of-library cases; not for "none": an effect there is a false alarm).
+* **right but flagged**: the right effects with status "partly explained"
   (counted as honest too).
 * **honest**: status "partly explained" or "not explained".
-* **confidently wrong**: status "explained" and not right; for
-  out-of-library cases every "explained" verdict (with an effect, or with
-  none although the data hold one).
+* **confidently wrong**: status "explained", neither right nor equivalent
+  (for out-of-library cases: every "explained" whose claimed system is not
+  equivalent, with an effect or with none).
 * **false alarm**: on a "none" case, any effect reported (whatever the status).
 * **size error**: ``|found - true| / |true change|`` (gains: the change of the
-  factor from 1) over the right single-effect (in-library) cases; beside it
-  the same for the fit told the true kind and place
-  (``diagnose(..., only=lambda h: (h.kind, h.station, h.element) == key)``),
-  over the same cases; their ratio should stay near 1.
+  factor from 1; a file's scale: ``|found / true - 1|``) over the right
+  single-effect (in-library) cases; beside it the same for the fit told the
+  true kind and place (``diagnose(..., only=lambda h: (h.kind, h.station,
+  h.element) == key)``), over the same cases; their ratio should stay near 1.
 * **seconds**: ``d.seconds`` of the diagnosis (median, max).
 
-Goals (printed with the totals): in-library >= 95 % right, two-effect
->= 90 % right, out-of-library 0 confidently wrong, false alarms <= 2 %.
+Goals (printed with the totals): in-library >= 95 % right (exact or
+equivalent), two-effect >= 90 % right (exact or equivalent), out-of-library 0
+confidently wrong, false alarms <= 2 %.
 
 Usage::
 
-    python benchmarks/bench_diagnose_open.py                   # 1 % noise, 164 cases (5 seeds), about 20 min/job
+    python benchmarks/bench_diagnose_open.py                   # 1 % noise, 176 cases (5 seeds), about 25 min/job
     python benchmarks/bench_diagnose_open.py --quick           # a handful of cases (about a minute)
     python benchmarks/bench_diagnose_open.py --noise 0.003 0.01 0.03 --jobs 2 --json rows.json
     python benchmarks/bench_diagnose_open.py --categories out_of_library --seeds 2
 
 Counts per example and noise level with ``--seeds S`` (default 5): in-library S
-per kind (7 kinds), two-effect 3 S, out-of-library ceil(0.4 S) per kind (11 kinds),
-none 2 S.  With S = 5 and both examples: 70 in-library, 30 two-effect,
-44 out-of-library and 20 none cases per noise level.
+per kind (9 kinds), two-effect 3 S, out-of-library ceil(0.4 S) per kind (9 kinds),
+none 2 S.  With S = 5 and both examples: 90 in-library, 30 two-effect,
+36 out-of-library and 20 none cases per noise level.
 """
 from __future__ import annotations
 
@@ -92,11 +112,11 @@ HERE = Path(__file__).resolve().parent
 if str(HERE) not in sys.path:
     sys.path.insert(0, str(HERE))
 
-from _open_world import CATEGORIES  # noqa: E402
+from _open_world import CATEGORIES, EQUIVALENT  # noqa: E402
 
 GOALS = {"in_library": 0.95, "two_effect": 0.90, "out_of_library": 0, "false_alarms": 0.02}
-QUICK = {"in_library": ("spring_change", "mass", "sensor_gain"), "two_effect": ("pair",),
-         "out_of_library": ("sensor_delay", "tuned_absorber", "unit_slip"), "none": ("none",)}
+QUICK = {"in_library": ("spring_change", "sensor_delay", "unit_slip"), "two_effect": ("pair",),
+         "out_of_library": ("rayleigh_damping", "tuned_absorber", "stiffness_loss"), "none": ("none",)}
 
 
 def case_list(examples, noises, seeds: int, first: int, categories, quick: bool):
@@ -139,31 +159,45 @@ def finding_row(f) -> dict:
             "at_bound": bool(getattr(f, "at_bound", False))}
 
 
-def _null(e) -> float:
-    return 1.0 if e["kind"].endswith("gain") else 0.0
+def size_error(e: dict, f) -> float:
+    """|found - true| / |true change| (gains: the change from 1; a file's scale: |found / true - 1|)."""
+    v = float(f["value"] if isinstance(f, dict) else f.value)
+    if e["kind"] == "channel_scale":
+        return abs(v / e["value"] - 1)
+    null = 1.0 if e["kind"].endswith("gain") else 0.0
+    return abs(v - e["value"]) / abs(e["value"] - null)
 
 
 def score(row: dict) -> dict:
-    """right, right_flagged, honest, confidently_wrong, false_alarm, size_err of one diagnosed case."""
+    """right, right_equiv, right_flagged, honest, confidently_wrong, false_alarm, size_err of one case."""
     cat, st = row["category"], row["status"]
-    key = sorted((e["kind"], e["station"]) for e in row["key_effects"])
-    found = sorted((f["kind"], f["station"]) for f in row["found"])
+    key = sorted(((e["kind"], e["station"]) for e in row["key_effects"]), key=str)
+    found = sorted(((f["kind"], f["station"]) for f in row["found"]), key=str)
     honest = st in ("partly explained", "not explained")
-    out = {"honest": honest, "right": None, "right_flagged": False, "confidently_wrong": False,
-           "false_alarm": None, "size_err": None}
+    explained = st == "explained"
+    eq = row.get("equiv")
+    equivalent = eq is not None and eq["error"] < EQUIVALENT * row["noise"]
+    out = {"honest": honest, "right": None, "right_equiv": False, "right_flagged": False,
+           "confidently_wrong": False, "false_alarm": None, "size_err": None}
     if cat == "out_of_library":
-        out["confidently_wrong"] = st == "explained"
+        out["right_equiv"] = explained and equivalent
+        out["confidently_wrong"] = explained and not equivalent
         return out
     match = found == key
-    out["right"] = st == "explained" and match
+    out["right"] = explained and match
+    out["right_equiv"] = explained and not match and equivalent and cat != "none"
     out["right_flagged"] = st == "partly explained" and match and bool(key)
-    out["confidently_wrong"] = st == "explained" and not match
+    out["confidently_wrong"] = explained and not match and not out["right_equiv"]
     if cat == "none":
         out["false_alarm"] = bool(found)
     if out["right"] and cat == "in_library":
-        e, f = row["key_effects"][0], row["found"][0]
-        out["size_err"] = abs(f["value"] - e["value"]) / abs(e["value"] - _null(e))
+        out["size_err"] = size_error(row["key_effects"][0], row["found"][0])
     return out
+
+
+def right_any(r) -> bool:
+    """Right, exactly or by an equivalent explanation."""
+    return bool(r.get("right")) or bool(r.get("right_equiv"))
 
 
 # ----------------------------------------------------------------------------------------------
@@ -176,7 +210,7 @@ def run_case(example, category, kind, seed, noise, workdir, told=True) -> dict:
         sys.path.insert(0, str(HERE))
     from threadpoolctl import threadpool_limits
 
-    from _open_world import make_case
+    from _open_world import equivalence_error, make_case
     from mutext.diagnose import diagnose
     row = {"example": example, "category": category, "kind": kind, "seed": seed, "noise": noise}
     try:
@@ -192,6 +226,11 @@ def run_case(example, category, kind, seed, noise, workdir, told=True) -> dict:
                        seconds=float(d.seconds), gain=float(getattr(d, "gain", math.nan)),
                        verdict=None if v is None else finding_row(v) | {"significant": bool(v.significant)},
                        notes=[str(x) for x in getattr(d, "notes", [])])
+            try:
+                eq = equivalence_error(case, row["found"])
+                row["equiv"] = eq | {"in_noise": eq["error"] / noise}
+            except (ValueError, StopIteration) as exc:      # a claim the generator has no physics for
+                row["equiv"], row["equiv_error"] = None, repr(exc)
             row.update(score(row))
             row["told_err"] = None
             if told and category == "in_library":
@@ -203,7 +242,7 @@ def run_case(example, category, kind, seed, noise, workdir, told=True) -> dict:
                     fs = getattr(dt, "findings", None) or effects_of(dt)
                     f = next((x for x in fs if x.kind != "none"), None)
                     if f is not None:
-                        row["told_err"] = abs(float(f.value) - e["value"]) / abs(e["value"] - _null(e))
+                        row["told_err"] = size_error(e, f)
                 except Exception as exc:     # noqa: BLE001 - the told fit is a reference, not the benchmark
                     row["told_error"] = repr(exc)
     except Exception as exc:                 # noqa: BLE001 - reported as a row with an error
@@ -226,9 +265,9 @@ def _med(xs):
 
 def table(rows, title):
     print(f"\n### {title}\n")
-    print("| category | cases | right | right but flagged | honest (partly/not explained) | confidently wrong "
-          "| false alarms | median size error | told kind+place | ratio | s median | s max |")
-    print("|---|---|---|---|---|---|---|---|---|---|---|---|")
+    print("| category | cases | right | right (equivalent) | right but flagged | honest (partly/not explained) "
+          "| confidently wrong | false alarms | median size error | told kind+place | ratio | s median | s max |")
+    print("|---|---|---|---|---|---|---|---|---|---|---|---|---|")
     for cat in CATEGORIES:
         rs = [r for r in rows if r["category"] == cat]
         if not rs:
@@ -236,6 +275,7 @@ def table(rows, title):
         ok = [r for r in rs if "error" not in r]
         errs = len(rs) - len(ok)
         right = "-" if cat == "out_of_library" else _pct(sum(bool(r["right"]) for r in ok), len(ok))
+        equiv = "-" if cat == "none" else _pct(sum(bool(r["right_equiv"]) for r in ok), len(ok))
         flagged = "-" if cat in ("out_of_library", "none") else str(sum(r["right_flagged"] for r in ok))
         fa = _pct(sum(bool(r["false_alarm"]) for r in ok), len(ok)) if cat == "none" else "-"
         right_rows = [r for r in ok if r.get("right")]
@@ -245,42 +285,99 @@ def table(rows, title):
         size = "-" if cat != "in_library" else f"{100 * se:.3g} %"
         told = "-" if cat != "in_library" else f"{100 * te:.3g} %"
         ratio = "-" if cat != "in_library" else f"{se / te:.2f}" if te and te > 0 else "nan"
-        print(f"| {cat} | {len(rs)}{f' ({errs} errors)' if errs else ''} | {right} | {flagged} | "
+        print(f"| {cat} | {len(rs)}{f' ({errs} errors)' if errs else ''} | {right} | {equiv} | {flagged} | "
               f"{_pct(sum(r['honest'] for r in ok), len(ok))} | "
               f"{_pct(sum(r['confidently_wrong'] for r in ok), len(ok))} | {fa} | {size} | {told} | {ratio} | "
               f"{_med(secs):.1f} | {max(secs) if secs else math.nan:.1f} |")
 
 
+def _claims(r) -> str:
+    return ", ".join(f"{f['kind']}@{f['station']}" for f in r["found"]) or "nothing"
+
+
+def _eq(r) -> str:
+    eq = r.get("equiv")
+    return "n/a" if eq is None else f"{eq['in_noise']:.3g}"
+
+
+_STATUS = {"explained": "E", "partly explained": "P", "not explained": "N"}
+
+
 def kind_table(rows):
-    print("\n| category | kind | cases | right | honest | confidently wrong | found when confidently wrong |")
-    print("|---|---|---|---|---|---|---|")
+    """Per kind of the categories with a right answer (in-library, two-effect, none)."""
+    print("\n| category | kind | cases | right | right (equivalent) | right but flagged | honest | confidently wrong "
+          "| claimed when confidently wrong |")
+    print("|---|---|---|---|---|---|---|---|---|")
     for cat, kinds in CATEGORIES.items():
+        if cat == "out_of_library":
+            continue
         for k in kinds:
             rs = [r for r in rows if r["category"] == cat and r["kind"] == k and "error" not in r]
             if not rs:
                 continue
-            wrong = Counter(", ".join(f"{f['kind']}@{f['station']}" for f in r["found"]) or "nothing"
-                            for r in rs if r["confidently_wrong"])
-            right = "-" if cat == "out_of_library" else str(sum(bool(r["right"]) for r in rs))
-            print(f"| {cat} | {k} | {len(rs)} | {right} | {sum(r['honest'] for r in rs)} | "
-                  f"{sum(r['confidently_wrong'] for r in rs)} | "
+            wrong = Counter(_claims(r) for r in rs if r["confidently_wrong"])
+            print(f"| {cat} | {k} | {len(rs)} | {sum(bool(r['right']) for r in rs)} | "
+                  f"{sum(bool(r['right_equiv']) for r in rs)} | {sum(bool(r['right_flagged']) for r in rs)} | "
+                  f"{sum(r['honest'] for r in rs)} | {sum(r['confidently_wrong'] for r in rs)} | "
                   f"{'; '.join(f'{w} x{c}' for w, c in wrong.most_common(4))} |")
 
 
+def open_kind_table(rows):
+    """Per out-of-library kind: how each was answered (statuses E explained, P partly, N not explained) and,
+    when explained, what was claimed and how far its system is from the true one (in noise units)."""
+    rs0 = [r for r in rows if r["category"] == "out_of_library" and "error" not in r]
+    if not rs0:
+        return
+    print(f"\nout of library, per kind (statuses: E explained, P partly explained, N not explained; equivalence "
+          f"error: rms |ln(H_claimed/H_true)| / noise, equivalent below {EQUIVALENT:.3g}):\n")
+    print("| kind | cases | honest | right (equivalent) | confidently wrong | statuses | explained as (equivalence "
+          "error) |")
+    print("|---|---|---|---|---|---|---|")
+    for k in CATEGORIES["out_of_library"]:
+        rs = [r for r in rs0 if r["kind"] == k]
+        if not rs:
+            continue
+        st = Counter(_STATUS.get(r["status"], r["status"]) for r in rs)
+        stx = " ".join(f"{s}{st[s]}" for s in ("E", "P", "N") if st[s])
+        expl = "; ".join(f"{r['example']} s{r['seed']}: {_claims(r)} ({_eq(r)})" for r in rs
+                         if r["status"] == "explained")
+        print(f"| {k} | {len(rs)} | {sum(r['honest'] for r in rs)} | {sum(bool(r['right_equiv']) for r in rs)} | "
+              f"{sum(r['confidently_wrong'] for r in rs)} | {stx} | {expl or '-'} |")
+
+
+def _found_text(r) -> str:
+    return "; ".join(f"{f['kind']}@{f['station']} ({f['element']} {f['value']:.4g} +/- {f['std']:.2g}"
+                     f"{', at bound' if f['at_bound'] else ''})" for f in r["found"]) or "nothing"
+
+
+def _key_text(r) -> str:
+    return "; ".join(f"{e['kind']}@{e['station']} ({e['element']} {e['value']:.4g})" for e in r["key_effects"]) \
+        or r["key"]["description"]
+
+
 def misses(rows):
-    bad = [r for r in rows if "error" not in r and (r["confidently_wrong"] or
-                                                     (r["category"] != "out_of_library" and not r["right"]))]
-    if bad:
-        print("\nnot right (in-library, two-effect, none) or confidently wrong (out-of-library):")
-    for r in bad:
-        key = "; ".join(f"{e['kind']}@{e['station']} ({e['element']} {e['value']:.4g})" for e in r["key_effects"]) \
-            or r["key"]["description"]
-        found = "; ".join(f"{f['kind']}@{f['station']} ({f['element']} {f['value']:.4g} +/- {f['std']:.2g}"
-                          f"{', at bound' if f['at_bound'] else ''})" for f in r["found"]) or "nothing"
+    ok = [r for r in rows if "error" not in r]
+    cw = [r for r in ok if r["confidently_wrong"]]
+    if cw:
+        print("\nconfidently wrong (status explained, claimed system not equivalent to the true one):")
+    for r in cw:
         sf = r["key"].get("single_fit") or {}
         best = f" [best single hypothesis leaves {sf['misfit']:.3g} x noise]" if sf else ""
         print(f"  {r['example']} {r['category']}/{r['kind']} seed {r['seed']} noise {r['noise']:g}: "
-              f"key {key}{best}; {r['status']}: {found}")
+              f"{r['status']}: {_found_text(r)}; truth {_key_text(r)}{best}; equivalence error {_eq(r)} x noise")
+    eqs = [r for r in ok if r["right_equiv"]]
+    if eqs:
+        print("\nright by an equivalent explanation:")
+    for r in eqs:
+        print(f"  {r['example']} {r['category']}/{r['kind']} seed {r['seed']} noise {r['noise']:g}: "
+              f"{_found_text(r)}; truth {_key_text(r)}; equivalence error {_eq(r)} x noise")
+    hon = [r for r in ok if r["category"] in ("in_library", "two_effect", "none") and not right_any(r)
+           and not r["confidently_wrong"]]
+    if hon:
+        print("\nnot right but honest (in-library, two-effect, none):")
+    for r in hon:
+        print(f"  {r['example']} {r['category']}/{r['kind']} seed {r['seed']} noise {r['noise']:g}: "
+              f"key {_key_text(r)}; {r['status']}: {_found_text(r)} (equivalence error {_eq(r)} x noise)")
     for r in rows:
         if "error" in r:
             print(f"  error: {r['example']} {r['category']}/{r['kind']} seed {r['seed']} noise {r['noise']:g}: "
@@ -294,9 +391,9 @@ def goals(rows):
     for cat in ("in_library", "two_effect"):
         rs = [r for r in ok if r["category"] == cat]
         if rs:
-            frac = sum(bool(r["right"]) for r in rs) / len(rs)
-            lines.append((f"{cat} right", _pct(sum(bool(r['right']) for r in rs), len(rs)),
-                          f">= {100 * GOALS[cat]:.0f} %", frac >= GOALS[cat]))
+            n = sum(right_any(r) for r in rs)
+            lines.append((f"{cat} right (exact or equivalent)", _pct(n, len(rs)), f">= {100 * GOALS[cat]:.0f} %",
+                          n / len(rs) >= GOALS[cat]))
     rs = [r for r in ok if r["category"] == "out_of_library"]
     if rs:
         n = sum(r["confidently_wrong"] for r in rs)
@@ -369,6 +466,7 @@ def main(argv=None):
         rs = [r for r in rows if r["noise"] == n]
         table(rs, f"noise {100 * n:g} %")
         kind_table(rs)
+        open_kind_table(rs)
     if len(args.noise) > 1:
         table(rows, "all noise levels")
     goals(rows)

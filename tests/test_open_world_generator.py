@@ -138,10 +138,84 @@ def test_in_library_keys_name_hypotheses_of_the_library(example):
         (e,) = case.key["effects"]
         assert (e["kind"], e["station"], e["element"]) in hyps, (kind, e)
         assert case.key["change"] >= ow.DETECTABLE
-        # the generator's own single-hypothesis fit finds the effect and leaves only rounding
+        # the generator's own single-hypothesis fit finds the effect and leaves only rounding (a file's scale
+        # and its sensor's gain are the same on the measured data when the sensor has one measured channel)
         fit = case.key["single_fit"]
         assert fit["misfit"] < 1e-3, (kind, fit)
-        assert (fit["kind"], fit["station"]) == (e["kind"], e["station"])
+        assert fit["station"] == e["station"], (kind, fit)
+        assert fit["kind"] == e["kind"] or {fit["kind"], e["kind"]} == {"sensor_gain", "channel_scale"}, (kind, fit)
+        # the key's claim is the true system
+        assert ow.equivalence_error(case, case.key["effects"])["error"] < 1e-12
+
+
+def test_sensor_delay_and_unit_slip_are_in_library_with_the_library_names():
+    assert {"sensor_delay", "unit_slip"} <= set(ow.IN_LIBRARY)
+    assert not {"sensor_delay", "unit_slip"} & set(ow.OUT_OF_LIBRARY)
+    for seed in range(3):
+        case = ow.make_case("three_mass", "in_library", "sensor_delay", seed=seed, noise=0.03)
+        (e,) = case.key["effects"]
+        chain = ow.read_chain(case.model_path)
+        assert (e["kind"], e["element"], e["unit"]) == ("sensor_delay", e["element"], "s")
+        assert e["station"] == chain.sensors[e["element"]] + 1
+        assert 0 < e["value"] < ow.DELAY_BOUNDS[1]
+        case = ow.make_case("four_story", "in_library", "unit_slip", seed=seed, noise=NOISE)
+        (e,) = case.key["effects"]
+        fo, se = e["element"].split("->")
+        assert e["kind"] == "channel_scale" and e["station"] == ow.read_chain(case.model_path).sensors[se] + 1
+        assert e["value"] in ow.UNIT_SLIPS
+
+
+def test_a_file_scale_and_its_sensor_gain_are_not_drawn_together():
+    for seed in range(40):
+        case = ow.make_case("three_mass", "two_effect", "unit_slip+sensor_gain", seed=seed, noise=NOISE)
+        a, b = case.key["effects"]
+        assert (a["kind"], b["kind"]) == ("channel_scale", "sensor_gain")
+        assert a["station"] != b["station"]
+
+
+def test_equivalent_explanations_are_told_from_wrong_ones():
+    """Proportional damping C -> (1 + a) C is every damper changed by a; a stiffness loss every spring changed
+    by -d: equivalent (to rounding).  Part of it, or a file's scale on the wrong file, is not."""
+    chain = ow.read_chain(ow.example_path("three_mass"))
+    case = ow.make_case("three_mass", "out_of_library", "stiffness_loss", seed=0, noise=NOISE)
+    d = case.key["details"]["value"]
+    every = [{"kind": "stiffness", "station": chain.station(e["between"]), "element": e["name"],
+              "value": -d * e["value"]} for e in chain.springs]
+    assert ow.equivalence_error(case, every)["error"] < 1e-9
+    assert ow.equivalence_error(case, every[:2])["error"] > ow.DETECTABLE * NOISE / 10
+    assert ow.equivalence_error(case, [])["error"] >= ow.DETECTABLE * NOISE
+    for seed in range(6):
+        case = ow.make_case("three_mass", "out_of_library", "rayleigh_damping", seed=seed, noise=NOISE)
+        if case.key["details"]["form"] == "C -> (1 + a) C":
+            break
+    a = case.key["details"]["value"]
+    every = [{"kind": "damping", "station": chain.station(e["between"]), "element": e["name"],
+              "value": a * e["value"]} for e in chain.dampers]
+    assert ow.equivalence_error(case, every)["error"] < 1e-9
+    assert ow.equivalence_error(case, every[1:])["error"] > NOISE * ow.EQUIVALENT
+    # kinds of the whole structure: all damping scaled, the frequency axis, a mass moving with the sensor
+    scale = [{"kind": "damping_scale", "station": None, "element": "damping", "value": a}]
+    assert ow.equivalence_error(case, scale)["error"] < 1e-9
+    for kind, claim in (("frequency_scale", "frequency_scale"), ("roving_mass", "sensor_mass")):
+        case = ow.make_case("four_story", "out_of_library", kind, seed=1, noise=NOISE)
+        v = case.key["details"]["value"]
+        claimed = [{"kind": claim, "station": None, "element": "-", "value": v}]
+        assert ow.equivalence_error(case, claimed)["error"] < 1e-9, kind
+        assert ow.equivalence_error(case, [{**claimed[0], "value": 0.5 * v}])["error"] > NOISE * ow.EQUIVALENT
+    # a unit slip: the measured file's scale shows on the measured files only
+    case = ow.make_case("three_mass", "in_library", "unit_slip", seed=0, noise=NOISE)
+    (e,) = case.key["effects"]
+    fo, se = e["element"].split("->")
+    other = next(f"{a}->{b}" for a, b in case.channels[0] if (a, b) != (fo, se))
+    wrong = [{**e, "element": other}]
+    err = ow.equivalence_error(case, wrong)
+    assert err["validate"] < 1e-12 and err["measured"] > 0.1
+    # the sensor's gain instead of its measured file's scale: the same measured files, other validation files
+    gain = [{"kind": "sensor_gain", "station": e["station"], "element": se, "value": e["value"]}]
+    err = ow.equivalence_error(case, gain)
+    assert err["measured"] < 1e-12 and err["validate"] > 0.1
+    with pytest.raises(ValueError):
+        ow.equivalence_error(case, [{"kind": "crack", "station": 1, "element": "x", "value": 0.1}])
 
 
 def test_two_effects_are_two_places_each_detectable():
@@ -210,18 +284,20 @@ def test_tuned_absorber_with_a_rigid_spring_is_a_mass_change():
 @pytest.mark.parametrize("example", sorted(ow.EXAMPLES))
 def test_unit_slip_scales_one_measured_file_exactly(example):
     for seed in range(4):
-        case = ow.make_case(example, "out_of_library", "unit_slip", seed=seed, noise=1e-12)
+        case = ow.make_case(example, "in_library", "unit_slip", seed=seed, noise=1e-12)
         chain = ow.read_chain(case.model_path)
         meas, val = ow.channels(chain)
         M, C, K = chain.matrices()
         f = ow.band_grid(M, K)
-        factor = case.key["details"]["value"]
+        (e,) = case.key["effects"]
+        factor = e["value"]
         assert factor in (1e-3, 1e-6, 25.4, -1.0)
         ratios = [frf.response / ref for frf, ref in zip(case.measured, _pkg_frf(case.model_path, f, meas))]
         slipped = [k for k, r in enumerate(ratios) if np.max(np.abs(r - 1)) > 1e-9]
         assert len(slipped) == 1
         np.testing.assert_allclose(ratios[slipped[0]], factor, rtol=1e-9)
-        assert case.key["details"]["channel"] == "->".join(meas[slipped[0]])
+        assert e["element"] == "->".join(meas[slipped[0]])
+        assert e["station"] == chain.sensors[meas[slipped[0]][1]] + 1
         fv = f + 0.5 * (f[1] - f[0])
         for frf, ref in zip(case.validate, _pkg_frf(case.model_path, fv, val)):   # the other files are right
             np.testing.assert_allclose(frf.response, ref, rtol=1e-9)
@@ -235,14 +311,15 @@ def test_frequency_scale_and_sensor_delay_are_what_they_say():
     f = case.measured[0].freq_hz
     for h, ref in zip(case.clean, _pkg_frf(case.model_path, f * (1 + eps), meas)):
         np.testing.assert_allclose(h, ref, rtol=1e-9)
-    case = ow.make_case("four_story", "out_of_library", "sensor_delay", seed=3, noise=NOISE)
-    det = case.key["details"]
+    case = ow.make_case("four_story", "in_library", "sensor_delay", seed=3, noise=NOISE)
+    (e,) = case.key["effects"]
     chain = ow.read_chain(case.model_path)
-    meas, _ = ow.channels(chain)
-    f = case.measured[0].freq_hz
-    for (fo, se), h, ref in zip(meas, case.clean, _pkg_frf(case.model_path, f, meas)):
-        want = ref * (np.exp(-2j * np.pi * f * det["value"]) if se == det["sensor"] else 1.0)
-        np.testing.assert_allclose(h, want, rtol=1e-9)
+    meas, val = ow.channels(chain)
+    for chans, clean, grid in ((meas, case.clean, case.measured[0].freq_hz),
+                               (val, case.clean_validate, case.validate[0].freq_hz)):
+        for (fo, se), h, ref in zip(chans, clean, _pkg_frf(case.model_path, grid, chans)):
+            want = ref * (np.exp(-2j * np.pi * grid * e["value"]) if se == e["element"] else 1.0)
+            np.testing.assert_allclose(h, want, rtol=1e-9)
 
 
 def test_roving_mass_differs_per_channel():
