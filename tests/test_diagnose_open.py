@@ -31,8 +31,8 @@ def _run(case, **kw):
     ("three_mass", "tuned_absorber", 0),
     ("three_mass", "nonadjacent_spring", 1),
     ("three_mass", "wrong_model_extra_mass", 0),
-    ("three_mass", "roving_mass", 0),
-    ("four_story", "frequency_scale", 0),
+    ("three_mass", "wrong_model_parameters", 0),
+    ("three_mass", "rayleigh_damping", 0),          # C + b K: stiffness-proportional, not a scale of C
 ])
 def test_out_of_library_effects_are_never_explained_with_a_wrong_cause(example, kind, seed):
     case = make_case(example, "out_of_library", kind, seed, NOISE)
@@ -48,9 +48,9 @@ def test_out_of_library_effects_are_never_explained_with_a_wrong_cause(example, 
 def test_a_nonlinear_spring_is_reported_as_data_no_linear_model_describes():
     case = make_case("three_mass", "out_of_library", "cubic_spring", 1, NOISE)
     d = _run(case)
-    assert not d.noise_reference.linear
+    assert not d.noise_reference.linear and d.fit_quality.nonlinear
     assert "no linear time-invariant model" in d.headline()
-    lo, hi = min(a for _, a, _, _ in d.noise_reference.structured), max(b for _, _, b, _ in d.noise_reference.structured)
+    lo, hi = min(a for _, a, _, _ in d.fit_quality.nonlinear), max(b for _, _, b, _ in d.fit_quality.nonlinear)
     fn = sorted(np.sqrt(np.linalg.eigvals(np.linalg.solve(*_mk(case)))).real / (2 * np.pi))
     assert any(lo - 0.5 <= f <= hi + 0.5 for f in fn)           # the structure sits at a resonance
 
@@ -76,24 +76,51 @@ def test_two_simultaneous_effects_are_found_as_two(kinds, seed):
 
 
 def test_a_unit_slip_in_one_file_is_found_and_named():
-    case = make_case("four_story", "out_of_library", "unit_slip", 0, NOISE)
-    factor = case.key["details"]["value"]
+    case = make_case("four_story", "in_library", "unit_slip", 0, NOISE)
+    (key,) = case.key["effects"]
+    factor = key["value"]
     d = _run(case)
     assert d.status == "explained", d.report()
     (f,) = d.effects
-    assert f.kind == "channel_scale"
+    assert (f.kind, f.station) == (key["kind"], key["station"]) == ("channel_scale", key["station"])
     assert abs(f.value - factor) <= 4 * f.std + 1e-6 * abs(factor)
     assert "unit slip" in f.sentence()
 
 
 def test_a_sensor_delay_is_found_with_its_size():
-    case = make_case("three_mass", "out_of_library", "sensor_delay", 1, NOISE)
-    tau = case.key["details"]["value"]
+    case = make_case("three_mass", "in_library", "sensor_delay", 1, NOISE)
+    (key,) = case.key["effects"]
+    tau = key["value"]
     d = _run(case)
     assert d.status == "explained", d.report()
     (f,) = d.effects
-    assert f.kind == "sensor_delay"
+    assert (f.kind, f.station) == (key["kind"], key["station"]) == ("sensor_delay", key["station"])
     assert abs(f.value - tau) <= 4 * f.std, (f.sentence(), tau)
+
+
+@pytest.mark.parametrize("example,kind,seed,found", [
+    ("three_mass", "rayleigh_damping", 1, "damping_scale"),      # C -> (1 + a) C
+    ("four_story", "frequency_scale", 0, "frequency_scale"),     # data at f (1 + eps) labelled f
+    ("three_mass", "roving_mass", 0, "sensor_mass"),             # a mass at each channel's own output
+])
+def test_structure_wide_and_sensor_kinds_are_found_with_their_size(example, kind, seed, found):
+    case = make_case(example, "out_of_library", kind, seed, NOISE)
+    true = case.key["details"]["value"]
+    d = _run(case)
+    assert d.status == "explained", d.report()
+    (f,) = d.effects
+    assert f.kind == found
+    assert abs(f.value - true) <= 4 * f.std, (f.sentence(), true)
+    assert d.gain > 3
+
+
+def test_a_damping_scale_is_written_into_the_model_file(tmp_path):
+    case = make_case("three_mass", "out_of_library", "rayleigh_damping", 1, NOISE)
+    d = diagnose(case.model_path, case.measured, validate=case.validate, out_dir=tmp_path)
+    from _open_world import read_chain
+    a = d.effects[0].value
+    before, after = read_chain(case.model_path), read_chain(tmp_path / "model_extended.toml")
+    np.testing.assert_allclose(after.matrices()[1], (1 + a) * before.matrices()[1], rtol=1e-7)
 
 
 def test_correlated_analyser_noise_does_not_make_a_right_model_wrong():

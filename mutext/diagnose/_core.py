@@ -20,6 +20,7 @@ from ._compare import _errors, _model_modes, _resonance_table, _summary
 from ._extend import _refit, extended_model_text, mbi_reading, write_model
 from ._hypotheses import Hypothesis, hypotheses
 from .faults import channel as _channel
+from .faults import structure as _structure
 from ._result import ChannelComparison, Diagnosis, Finding
 from ._channels import _resolve, _src
 from ._fit_quality import fit_quality, noise_reference
@@ -139,7 +140,7 @@ def _diagnose(model, frfs, validate, alpha, refit, noise, out_dir, progress, onl
     summary = _summary(rows, chans, before)
 
     # 2. the hypotheses, screened, the best refitted on the extended model, the verdict
-    hyps = hypotheses(eng) + _channel.candidates(eng, chans)
+    hyps = hypotheses(eng) + _channel.candidates(eng, chans) + _structure.candidates(eng)
     if only is not None:
         hyps = [h for h in hyps if only(h)]
         if not hyps:
@@ -551,7 +552,7 @@ def _after(verdict, text, path, rec, chans, all_fit, held):
     """Responses of the extended model on the fitted channels and on the held-out data."""
     if verdict.kind == "none":
         return None, held.H0
-    if verdict.hypothesis.gain is not None:
+    if verdict.hypothesis.gain is not None or verdict.hypothesis.glob is not None:
         return (_Evaluator(rec, all_fit, verdict.hypothesis).responses(verdict.value),
                 _Evaluator(rec, held, verdict.hypothesis).responses(verdict.value))
     # the extended model file itself, loaded as a user would load it

@@ -14,6 +14,7 @@ from ..rotor.model import loads_model
 from ..rotor.tuning import DB_PER_NEPER, tune
 from ._result import Diagnosis, Finding
 from ._screen import _Data
+from .faults import structure as _structure
 
 def _toml_number(x: float) -> str:
     return f"{x:.8g}" if "e" not in f"{x:.8g}" else f"{x:.8e}"
@@ -57,7 +58,9 @@ def extended_model_text(model_text: str, finding: Finding, model) -> str:
     lay = model.layout
     if h is None or finding.kind == "none":
         return model_text
-    if finding.kind in ("sensor_gain", "channel_scale", "sensor_delay"):
+    if h.glob is not None:
+        return header + _structure.model_text(model_text, finding, note)
+    if finding.kind in ("sensor_gain", "channel_scale", "sensor_delay", "sensor_mass"):
         return header + "# (a correction of the measurement: the model itself is unchanged)\n" + model_text
     if lay.kind == "lumped":
         names = lay.node_names
@@ -76,8 +79,9 @@ def extended_model_text(model_text: str, finding: Finding, model) -> str:
     # rotors
     if h.kind == "bearing":
         key = "stiffness" if h.order == 0 else "damping"
+        new = finding.new_value if finding.new_value is not None else h.nominal + finding.value
         return header + _replace_value(model_text, "bearing", lambda t: t.get("station") == h.station,
-                                       doc.get("bearing", []), key, finding.new_value, note)
+                                       doc.get("bearing", []), key, new, note)
     if h.kind == "exciter_gain":
         st = h.gain[1]
         port = model.inputs[st[1]] if st[0] == "port" else None

@@ -13,12 +13,13 @@ from ..rotor.elements import BearingElement, Damper, ParameterSet, PointMass, Sp
 from ..rotor.model import load_model
 from ._channels import _resolve
 from .faults import channel as _channel
+from .faults import structure as _structure
 from .faults._base import Hypothesis
 
 log = logging.getLogger("mutext.diagnose")
 
 #: Kinds of finding (the ``kind`` field of :class:`~mutext.diagnose.Finding`).
-KINDS = ("stiffness", "mass", "damping", "crack", "bearing") + _channel.KINDS + ("none",)
+KINDS = ("stiffness", "mass", "damping", "crack", "bearing") + _channel.KINDS + _structure.KINDS + ("none",)
 
 _ORDER = {"stiffness": 0, "damping": 1, "mass": 2}      # D(w) = S * (1, j w, -w^2)[order]
 

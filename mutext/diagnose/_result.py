@@ -55,6 +55,8 @@ class Finding:
             return f"x{self.value:.4g}" + (f" +/- {self.std:.2g}" if std else "")
         if self.kind == "crack":
             return f"a/D {self.value:.4g}" + (f" +/- {self.std:.2g}" if std else "")
+        if self.kind in ("damping_scale", "frequency_scale"):
+            return f"{100 * self.value:+.4g}" + (f" +/- {100 * self.std:.2g}" if std else "") + " %"
         if self.kind == "sensor_delay":
             return f"{1e3 * self.value:+.4g}" + (f" +/- {1e3 * self.std:.2g}" if std else "") + " ms"
         return f"{self.value:+.4g}" + (f" +/- {self.std:.2g}" if std else "") + f" {self.unit}"
@@ -176,10 +178,9 @@ class Diagnosis:
             return f"EXPLAINED: {eff}"
         left = "" if q is None else (f"the residual stays at {q.misfit:.3g} times the noise "
                                      f"(at most {q.limit:.3g} if explained), {q.where()}")
-        nr = self.noise_reference
-        if nr is not None and not nr.linear:
+        if q is not None and q.nonlinear:
             left += ("; " if left else "") + "no linear time-invariant model describes the data at " + ", ".join(
-                f"{c} {a:.4g}-{b:.4g} Hz" for c, a, b, _ in nr.structured[:3]) + (
+                f"{c} {a:.4g}-{b:.4g} Hz" for c, a, b, _ in q.nonlinear[:3]) + (
                 " (a response that depends on the amplitude, a time-varying system, or leakage)")
         if self.status == "partly explained":
             return (f"PARTLY EXPLAINED: {eff} helps (held-out gain {self.gain:.3g}x) but {left}; "

@@ -9,6 +9,7 @@ import numpy as np
 from ._channels import _Chan
 from ._hypotheses import Hypothesis
 from .faults import channel as _channel
+from .faults import structure as _structure
 
 
 class _Receptance:
@@ -17,6 +18,7 @@ class _Receptance:
     def __init__(self, model, values, speed, omega, chunk_bytes=64_000_000):
         M, C, K, G = model.matrices(values)
         self.B = model.input_matrix(values)
+        self.D = C + speed * G
         self.omega = np.asarray(omega, float)
         n = M.shape[0]
         D = C + speed * G
@@ -69,11 +71,11 @@ class _Evaluator:
     """Responses of the channels of a data set under one hypothesis, exactly for any size."""
 
     def __init__(self, rec: _Receptance, data: _Data, hyp: Hypothesis):
-        self.hyp, self.data = hyp, data
+        self.hyp, self.data, self.rec = hyp, data, rec
         self.pieces = []
         U = hyp.dofs
         for k, (ch, idx) in enumerate(zip(data.chans, data.idx)):
-            if hyp.gain is not None:
+            if hyp.gain is not None or hyp.glob is not None:
                 self.pieces.append(None)
                 continue
             Rb, Ro = data.columns(rec, k)
@@ -94,10 +96,14 @@ class _Evaluator:
     def responses(self, theta: float, derivative: bool = False):
         """Per channel ``H(theta)`` (and ``dH/dtheta`` when asked)."""
         h = self.hyp
+        if h.glob is not None:
+            Hs = _structure.responses(self.rec, self.data, [h], [theta])
+            return (Hs, [None] * len(Hs)) if derivative else Hs
         Hs, dHs = [], []
         for k, (ch, H0, piece) in enumerate(zip(self.data.chans, self.data.H0, self.pieces)):
             if h.gain is not None:
-                g, dg = _channel.factor(h, ch, self.data.freq_hz[k], theta)
+                Roo = self.data.columns(self.rec, k)[1][:, ch.out_dof] if h.gain[0] == "sensor_mass" else None
+                g, dg = _channel.factor(h, ch, self.data.freq_hz[k], theta, Roo)
                 Hs.append(H0 if g is None else H0 * g)
                 dHs.append(np.zeros_like(H0) if g is None else H0 * dg)
                 continue
@@ -146,15 +152,17 @@ def _fit_size(ev: _Evaluator, n_scan: int = 25, gn_iter: int = 30):
     if h.gain is not None:
         # the measurement chain enters the log residual linearly: closed form (both signs of a gain)
         cands = _channel.fit(h, ev.data.chans, ev.data.H0, meas, ev.data.freq_hz)
-        return min(((t, rss(t)) for t in cands), key=lambda x: x[1])
+        if cands is not None:
+            return min(((t, rss(t)) for t in cands), key=lambda x: x[1])
 
-    # scan: the null size, and sizes over four decades either side of the typical scale
-    mags = h.scale * np.logspace(-3, 1, n_scan)
+    # scan: the null size, and sizes over four decades either side of the typical scale (a structure-wide
+    # change costs a full solve per evaluation: a coarser scan, the bounded search refines it)
+    mags = h.scale * np.logspace(-3, 1, n_scan if h.glob is None else 9)
     grid = [0.0] + [m for m in mags if h.lower <= m <= h.upper] + [-m for m in mags if h.lower <= -m <= h.upper]
     vals = [rss(t) for t in grid]
     k = int(np.argmin(vals))
     t, best = grid[k], vals[k]
-    if h.crack is not None:
+    if h.crack is not None or h.glob is not None:
         # the bounds belong to the scan (the log grid's last point below a depth ratio of 0.5 is 0.464):
         # a crack at or near its bound must be reachable
         for e in (h.lower, h.upper):
@@ -203,11 +211,11 @@ def _jacobian_std(ev: _Evaluator, theta: float, s2: float) -> float:
     h = ev.hyp
     if h.gain is not None:
         Hs, dHs = ev.responses(theta, derivative=True)
-    elif h.crack is None:
+    elif h.crack is None and h.glob is None:
         Hs, dHs = ev.responses(theta, derivative=True)
     else:
-        d = max(1e-4, 1e-3 * abs(theta))
-        lo, hi = max(theta - d, 0.0), theta + d
+        d = max(1e-4 * h.scale, 1e-3 * abs(theta))
+        lo, hi = max(theta - d, h.lower), min(theta + d, h.upper)
         Hl, Hh = ev.responses(lo), ev.responses(hi)
         Hs = ev.responses(theta)
         dHs = [(b - a) / (hi - lo) for a, b in zip(Hl, Hh)]

@@ -32,6 +32,7 @@ import scipy.optimize as so
 
 from ._screen import _Data, _Receptance
 from .faults import channel as _channel
+from .faults import structure as _structure
 
 #: Largest number of effects forward selection accepts.
 MAX_EFFECTS = 3
@@ -41,8 +42,8 @@ class Compound:
     """Responses of the channels of a data set under several hypotheses, exactly for any sizes."""
 
     def __init__(self, rec: _Receptance, data: _Data, hyps: list):
-        self.hyps, self.data = list(hyps), data
-        struct = [h for h in self.hyps if h.gain is None]
+        self.hyps, self.data, self.rec = list(hyps), data, rec
+        struct = [h for h in self.hyps if h.gain is None and h.glob is None]
         U = sorted({d for h in struct for d in h.dofs})
         self.U = U
         nU = len(U)
@@ -65,7 +66,7 @@ class Compound:
         nU = len(self.U)
         D = np.zeros((w.size, nU, nU), complex)
         for h, t in zip(self.hyps, thetas):
-            if h.gain is not None:
+            if h.gain is not None or h.glob is not None:
                 continue
             E = self.embed[id(h)]
             if h.crack is not None:
@@ -76,6 +77,8 @@ class Compound:
         return D
 
     def responses(self, thetas) -> list:
+        if any(h.glob is not None or (h.gain is not None and h.gain[0] == "sensor_mass") for h in self.hyps):
+            return _structure.responses(self.rec, self.data, self.hyps, thetas)
         out = []
         nU = len(self.U)
         for k, (ch, H0, piece) in enumerate(zip(self.data.chans, self.data.H0, self.pieces)):
@@ -129,10 +132,11 @@ def fit_one_given(rec, data, fixed: list, thetas: list, h):
     def rss(t):
         return _safe_rss(comp, list(thetas) + [t])
     if h.gain is not None:
-        # the measurement chain is linear in the log residual: closed form on the responses given the others
+        # the measurement chain is (mostly) linear in the log residual: closed form on the responses given the others
         base = Compound(rec, data, fixed).responses(thetas) if fixed else data.H0
-        return min(((t, rss(t)) for t in _channel.fit(h, data.chans, base, data.meas, data.freq_hz)),
-                   key=lambda x: x[1])
+        cands = _channel.fit(h, data.chans, base, data.meas, data.freq_hz)
+        if cands is not None:
+            return min(((t, rss(t)) for t in cands), key=lambda x: x[1])
     grid = _scan_grid(h, n=10)
     vals = [rss(t) for t in grid]
     j = int(np.argmin(vals))

@@ -38,7 +38,10 @@ class Hypothesis:
     gain : tuple or None
         Effects on the measurement chain (:mod:`mutext.diagnose.faults.channel`):
         ``("sensor", out_dof)``, ``("exciter", input column spec)``, ``("channel", FRF)`` or
-        ``("delay", out_dof)``.
+        ``("delay", out_dof)``; ``("sensor_mass", None)``: a mass that moves with the sensor.
+    glob : str or None
+        A change of the whole structure, evaluated by a full solve
+        (:mod:`mutext.diagnose.faults.structure`): ``"frequency_scale"``, ``"damping_scale"``.
     parameter : str or None
         Parameter of the *extended* model that holds the size (for the full fit).
     nominal : float
@@ -61,6 +64,7 @@ class Hypothesis:
     parameter: str | None = None
     nominal: float = 0.0
     crack: object = None          # callable depth -> dK on dofs (crack hypotheses)
+    glob: str | None = None       # a change of the whole structure (:mod:`mutext.diagnose.faults.structure`)
 
     @property
     def label(self) -> str:

@@ -8,6 +8,8 @@ kind               factor on a channel            acts on
 ``channel_scale``  :math:`g`                      one fitted file only (a unit slip or reversed
                                                   polarity in that file: other files are right)
 ``sensor_delay``   :math:`e^{-j\omega\tau}`       every channel of one sensor
+``sensor_mass``    :math:`1/(1 - m\omega^2 R_{oo})` every channel, at its own output: a mass that
+                                                  moves with the sensor (a roving accelerometer)
 =================  =============================  ==============================================
 
 A gain may be negative (a reversed polarity: the phase of data over model
@@ -25,7 +27,7 @@ import numpy as np
 
 from ._base import Hypothesis
 
-KINDS = ("sensor_gain", "exciter_gain", "channel_scale", "sensor_delay")
+KINDS = ("sensor_gain", "exciter_gain", "channel_scale", "sensor_delay", "sensor_mass")
 
 #: Magnitude range of a sensor's or exciter's gain, and of a channel's scale.
 GAIN_RANGE = (0.2, 5.0)
@@ -35,13 +37,15 @@ DELAY_RANGE = (-0.01, 0.01)
 
 
 def is_log_sized(h: Hypothesis) -> bool:
-    """Whether the size is a factor (compared in log terms), not a delay."""
-    return h.gain is not None and h.gain[0] != "delay"
+    """Whether the size is a factor (compared in log terms), not a delay or a mass."""
+    return h.gain is not None and h.gain[0] not in ("delay", "sensor_mass")
 
 
 def hits(h: Hypothesis, ch) -> bool:
     """Whether the effect acts on channel ``ch``."""
     what, key = h.gain
+    if what == "sensor_mass":
+        return True
     if what in ("sensor", "delay"):
         return ch.out_dof == key
     if what == "exciter":
@@ -49,10 +53,17 @@ def hits(h: Hypothesis, ch) -> bool:
     return ch.frf is key                     # "channel": one file's data
 
 
-def factor(h: Hypothesis, ch, f_hz, theta: float):
-    """The factor on channel ``ch`` at ``f_hz``, and its derivative in ``theta`` (None, None if not hit)."""
+def factor(h: Hypothesis, ch, f_hz, theta: float, Roo=None):
+    """The factor on channel ``ch`` at ``f_hz``, and its derivative in ``theta`` (None, None if not hit).
+
+    ``Roo``: the engineering model's direct receptance at the channel's output (a sensor's mass only)."""
     if not hits(h, ch):
         return None, None
+    if h.gain[0] == "sensor_mass":
+        # Z + theta (-w^2) e_o e_o^T: H / (1 - theta w^2 R_oo) (Sherman-Morrison)
+        q = (2 * np.pi * np.asarray(f_hz, float)) ** 2 * Roo
+        d = 1.0 / (1.0 - theta * q)
+        return d, q * d * d
     if h.gain[0] == "delay":
         w = 2 * np.pi * np.asarray(f_hz, float)
         e = np.exp(-1j * w * theta)
@@ -68,6 +79,8 @@ def fit(h: Hypothesis, chans, H0s, meas, freqs):
         if hits(h, ch):
             r.append(np.log(H0 / m))
             w.append(2 * np.pi * np.asarray(f, float))
+    if h.gain[0] == "sensor_mass":
+        return None                          # not linear in the log residual: the caller scans
     if not r:
         return [1.0 if is_log_sized(h) else 0.0]
     r, w = np.concatenate(r), np.concatenate(w)
@@ -98,6 +111,13 @@ def candidates(model, channels) -> list[Hypothesis]:
             out.append(Hypothesis("exciter_gain", ch.in_station, ch.in_name, f"gain of {what} {ch.in_name}",
                                   "1", False, GAIN_RANGE[0], GAIN_RANGE[1], 1.0, gain=("exciter", ch.in_spec),
                                   nominal=1.0))
+    outs = {ch.out_dof for ch in channels}
+    if len(outs) > 1:              # one output: a mass there is the same (mutext.diagnose, point masses)
+        M = model.matrices()[0]
+        total = float(np.sum(M[0::4, 0::4])) if model.layout.kind == "rotor" else float(np.trace(M))
+        out.append(Hypothesis("sensor_mass", None, "sensor", "a mass that moves with the sensor (at each "
+                              "channel's output)", "kg", True, 0.0, 0.2 * total, 1e-3 * total,
+                              gain=("sensor_mass", None)))
     if len(channels) > 1:          # with one channel a file's scale is the sensor's gain
         for ch in channels:
             src = str(ch.frf.source) if ch.frf.source else ch.label
