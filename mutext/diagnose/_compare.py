@@ -66,7 +66,9 @@ def _resonance_table(chans, before, model, speed, noise, unmatched: dict | None 
     for ch, Hb in zip(chans, before):
         f = ch.frf.freq_hz
         try:
-            res = resonances(f, ch.frf.response, noise=noise)
+            # the mobility j w H has the receptance's poles without its rise towards 0 Hz (rigid-body
+            # motion, a soft support), which a fit of the receptance can mistake for low resonances
+            res = resonances(f, 2j * np.pi * f * ch.frf.response, noise=noise)
         except ModelError as exc:
             log.debug("no resonances for %s: %s", ch.label, exc)
             continue
@@ -85,8 +87,9 @@ def _resonance_table(chans, before, model, speed, noise, unmatched: dict | None 
         for i, j in pairs:
             r, (fmod, zmod) = res[i], mods[j]
             peak_model = float(np.interp(fmod, f, np.abs(Hb)))
+            peak = float(np.interp(r.freq_hz, f, np.abs(ch.frf.response)))      # of the receptance
             rows.append(ResonanceRow(ch.label, r.freq_hz, r.freq_std, fmod, r.damping_ratio, r.damping_std, zmod,
-                                     r.peak, peak_model))
+                                     peak, peak_model))
     return rows
 
 

@@ -122,7 +122,7 @@ def _diagnose(model, frfs, validate, alpha, refit, noise, out_dir, progress, onl
         if progress is not None:
             progress(stage, frac)
 
-    path, eng, model_text, chans, vchans, speed = _inputs(model, frfs, validate, alpha)
+    path, eng, model_text, chans, vchans, speed, input_notes = _inputs(model, frfs, validate, alpha)
     tell("noise level of the data (model-free rational fits)", 0.01)
     ref = noise_reference(chans, _noise(noise))
     noise = ref.sigma
@@ -149,7 +149,7 @@ def _diagnose(model, frfs, validate, alpha, refit, noise, out_dir, progress, onl
     rss0 = _rss(fit.H0, fit.meas)
     threshold = float(sst.chi2.isf(alpha / len(hyps), 1))
     findings = _screen_all(hyps, rec, fit, s2, N, rss0, threshold, tell)
-    notes = _refit_best(findings, refit, model_text, path, eng, fit, s2, N, rss0, threshold, tell)
+    notes = input_notes + _refit_best(findings, refit, model_text, path, eng, fit, s2, N, rss0, threshold, tell)
     for f in findings:
         _judge(f, N, threshold)
     for f in findings[:5]:
@@ -330,6 +330,15 @@ def _inputs(model, frfs, validate, alpha):
             if _same_data(v, f):
                 raise ModelError(f"validation file {_src(v, 0)} holds the same data as the fitted "
                                  f"{_src(f, 0)}: held-out data must not be used in the fit")
+    notes: list = []
+    if eng.layout.kind == "lumped":
+        # a chain moves along one direction: a file's Y (an analyser's default axis) is that direction
+        fit_frfs, val_frfs = _along_the_chain(fit_frfs, notes), _along_the_chain(val_frfs, notes)
+    for k, f in enumerate(fit_frfs + val_frfs, start=1):
+        for n in (f.metadata.get("notes") or []):
+            notes.append(f"{_src(f, k)}: {n}")
+        if f.metadata.get("conversion"):
+            notes.append(f"{_src(f, k)}: {f.metadata['conversion']}")
     chans, _ = _resolve(eng, fit_frfs, "data")
     vchans, _ = _resolve(eng, val_frfs, "validation") if val_frfs else ([], None)
     speeds = {c.speed for c in chans + vchans}
@@ -345,7 +354,7 @@ def _inputs(model, frfs, validate, alpha):
         raise ModelError(f"diagnose: the data cover {fmin:g}-{fmax:g} Hz but the model has no resonance there "
                          f"(model resonances: {', '.join(f'{x:.4g}' for x in fmodes[:6])} Hz): check the units of "
                          f"the frequency column and that the file belongs to this model")
-    return path, eng, model_text, chans, vchans, speed
+    return path, eng, model_text, chans, vchans, speed, list(dict.fromkeys(notes))
 
 
 def _noise(noise) -> float | None:
@@ -355,6 +364,19 @@ def _noise(noise) -> float | None:
     if isinstance(noise, bool) or not (isinstance(noise, (int, float)) and math.isfinite(noise) and 0 < noise < 1):
         raise ModelError(f"diagnose: noise must be a relative level in (0, 1), e.g. 0.01 for 1 %; got {noise!r}")
     return max(float(noise), 1e-6)
+
+
+def _along_the_chain(frfs: list, notes: list) -> list:
+    """FRFs of a lumped chain with their directions set to the chain's one (x), with a note."""
+    from dataclasses import replace
+    out = []
+    for k, f in enumerate(frfs, start=1):
+        if f.input_direction != "x" or f.output_direction != "x":
+            notes.append(f"{_src(f, k)}: measured along {f.input_direction}/{f.output_direction}; a lumped chain "
+                         "moves along one direction, taken as that one")
+            f = replace(f, input_direction="x", output_direction="x", metadata=dict(f.metadata))
+        out.append(f)
+    return out
 
 
 def _group_unmatched(rows: list) -> list:
@@ -409,6 +431,10 @@ def _select_more(effects, hyps, rec, fit, held, s2, N, threshold, alpha, ref, no
         base = [e.hypothesis for e in effects]
         rss_a = _rss_of(Compound(rec, fit, base).responses(thetas), fit.meas)
         held_a = _rss_of(Compound(rec, held, base).responses(thetas), held.meas)
+        if not held_a < _rss_of(held.H0, held.meas):
+            notes.append(f"no further effect searched: the {len(effects)} effect(s) found do not improve the "
+                         "held-out data")
+            break
         cands = []
         for h in hyps:
             if any(h is b for b in base):
@@ -498,6 +524,13 @@ def _refit_best(findings, refit, model_text, path, eng, fit, s2, N, rss0, thresh
     """Refit the best few on the extended model file itself (with modal damping the damping matrix follows
     the changed stiffness and mass there, unlike in the screen); returns notes on refits that failed."""
     notes, n_ref = [], 0
+    left = (findings[0].score - math.log(N)) / N if findings else 0.0
+    if left > 10:
+        # no single hypothesis comes near the noise: the refit's small correction of a size is not what
+        # decides this diagnosis (its cost is: a tune per hypothesis)
+        notes.append(f"the best single hypothesis leaves {left:.3g} times the noise's misfit: sizes are the "
+                     "screen's, not refitted on the extended model")
+        return notes
     for f in findings:
         if n_ref >= refit:
             break

@@ -48,17 +48,19 @@ A stepped-sine sweep has independent lines (:math:`r_1 \approx 0`).  Noise
 given by the user (``noise=``, e.g. from repeated sweeps) is taken as exact
 (:math:`\nu = \infty`).
 
-Data no linear model describes
-------------------------------
+Data the rational reference does not describe
+---------------------------------------------
 Correlated noise spreads evenly over the band; a nonlinearity (a response
-that depends on the amplitude), a time-varying system or leakage leaves
-*structure* where the response is large.  When the rational reference of a
-channel leaves bands above its own level (the window test below) and its
-level exceeds the local fourth-difference level
-(:func:`mutext.frfit.noise_level`) by more than 30 %, no linear model of that
-order describes the channel: the bands are reported, the local level is used
-as the noise, and the result is never *explained* while the final model
-misses those bands too.
+that depends on the amplitude), a time-varying system, leakage -- or simply
+more modes than the reference's order holds -- leave *structure* where the
+response is large.  When the rational reference of a channel leaves bands
+above its own level (the window test below) and its level exceeds the local
+fourth-difference level (:func:`mutext.frfit.noise_level`) by more than 30 %,
+the reference is not at the noise: the local level is used as the noise (with
+the fourth differences' smaller, approximate degrees of freedom), and the bands
+the final model misses too are reported.  The reference cannot say which of
+those causes it is; repeated sweeps at another force level can (amplitude
+dependence).
 
 Where the misfit is
 -------------------
@@ -277,4 +279,4 @@ def fit_quality(residuals, freqs, labels, s2: float, k: int, ref: NoiseReference
     # (a reference that underfits the edge of the band is not evidence against a model that fits it)
     unlinear = [(c, a, b, m) for c, a, b, m in ref.structured
                 if any(c == c2 and a <= b2 and a2 <= b for c2, a2, b2, _ in bands)]
-    return FitQuality(phi, limit, p, bool(phi <= limit and not unlinear), df1, chans, bands, unlinear)
+    return FitQuality(phi, limit, p, bool(phi <= limit), df1, chans, bands, unlinear)

@@ -179,9 +179,10 @@ class Diagnosis:
         left = "" if q is None else (f"the residual stays at {q.misfit:.3g} times the noise "
                                      f"(at most {q.limit:.3g} if explained), {q.where()}")
         if q is not None and q.nonlinear:
-            left += ("; " if left else "") + "no linear time-invariant model describes the data at " + ", ".join(
+            left += ("; " if left else "") + "even a model-free rational fit stays above the noise at " + ", ".join(
                 f"{c} {a:.4g}-{b:.4g} Hz" for c, a, b, _ in q.nonlinear[:3]) + (
-                " (a response that depends on the amplitude, a time-varying system, or leakage)")
+                " (a response that depends on the amplitude, a time-varying system, leakage, or more modes "
+                "than that fit holds)")
         if self.status == "partly explained":
             return (f"PARTLY EXPLAINED: {eff} helps (held-out gain {self.gain:.3g}x) but {left}; "
                     f"uncertainties are inflated by the misfit, and the cause may lie beyond the hypotheses")
