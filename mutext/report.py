@@ -107,6 +107,22 @@ def diagnosis_figures(result, outdir) -> list[str]:
     ax.tick_params(axis="y", labelsize=7)
     ax.legend(fontsize=7)
     paths.append(_save(fig, outdir, "ranking.png"))
+    loc = result.localized
+    if loc is not None:
+        # what the station where the misfit lives asks for, beside its reading as mass, damper and spring
+        f = np.asarray(loc["freq_hz"])
+        z, zf = np.asarray(loc["required_impedance"]), np.asarray(loc["msd_fit"])
+        fig, ax = plt.subplots(2, 1, figsize=(6.5, 4.5), sharex=True)
+        ax[0].semilogy(f, np.abs(z), ".", ms=3, label="required (one value per frequency)")
+        ax[0].semilogy(f, np.abs(zf), "-", label="mass, damper, spring to ground")
+        ax[0].set_ylabel("|z| [N/m]")
+        ax[0].legend(fontsize=7)
+        ax[0].set_title(f"impedance at station {loc['station']}, where the misfit lives", fontsize=9)
+        ax[1].plot(f, np.degrees(np.angle(z)), ".", ms=3)
+        ax[1].plot(f, np.degrees(np.angle(zf)), "-")
+        ax[1].set_ylabel("phase [deg]")
+        ax[1].set_xlabel("frequency [Hz]")
+        paths.append(_save(fig, outdir, "impedance.png"))
     return paths
 
 

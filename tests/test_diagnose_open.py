@@ -167,3 +167,19 @@ def test_a_size_at_the_bound_of_its_range_is_not_significant():
     assert gain.at_bound and not gain.significant and abs(gain.value) == pytest.approx(5.0)
     assert "exciter_gain" not in {f.kind for f in d.effects}
     assert d.status != "explained", d.report()       # the held-out files of that exciter say so
+
+
+@pytest.mark.parametrize("example,seed", [("three_mass", 0), ("four_story", 1)])
+def test_an_unmodelled_absorber_is_localised_at_its_station(example, seed, tmp_path):
+    """No hypothesis holds a tuned-mass absorber (an added degree of freedom): the diagnosis says so and
+    finds where it acts, and the report shows the impedance that station asks for."""
+    case = make_case(example, "out_of_library", "tuned_absorber", seed, NOISE)
+    d = _run(case)
+    assert d.status != "explained"
+    loc = d.localized
+    assert loc["station"] == case.key["details"]["station"], loc["ranking"]
+    assert loc["misfit"] < 2 and loc["ranking"][1]["misfit"] > 10 * loc["misfit"]
+    assert any("best explained at station" in n for n in d.notes)
+    from mutext.report import write_diagnosis
+    paths = write_diagnosis(d, tmp_path)
+    assert any(p.endswith("impedance.png") for p in paths["figures"])

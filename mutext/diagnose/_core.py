@@ -204,10 +204,17 @@ def _diagnose(model, frfs, validate, alpha, refit, noise, out_dir, progress, onl
     if effects and not gain > 1:
         notes.append(f"the extended model fits the held-out data worse than the engineering model "
                      f"(gain {gain:.3g}x): it is not a fix")
+    localized = None
+    if status != "explained":
+        tell("where the misfit lives (an impedance at each station)", 0.955)
+        from ._localize import describe, localize
+        localized = localize(rec, fit, held, eng, s2)
+        if localized is not None:
+            notes.append(describe(localized))
     result = Diagnosis(eng.name, path, noise, findings, verdict, ambiguous, sensor, err_before, err_after, gain,
                        held_desc, comps, rows, summary, threshold, alpha, len(hyps), text,
                        time.perf_counter() - t0, notes, N, status=status, effects=effects, fit_quality=quality,
-                       noise_reference=ref, unmatched=unmatched)
+                       noise_reference=ref, unmatched=unmatched, localized=localized)
     if speed > 0 and hasattr(eng, "n_stations"):
         # where to look: the modes of the best time-invariant model (a mode the engineering model misplaces
         # is not a sideband)
@@ -225,10 +232,17 @@ def _diagnose(model, frfs, validate, alpha, refit, noise, out_dir, progress, onl
                                           held, s2, rss0, verdict, err_after, result.notes)
             result.seconds = time.perf_counter() - t0
         _sideband_claim(result)
-    if mbi and verdict is not none:
+    at = verdict
+    if mbi and localized is not None and eng.layout.kind == "lumped":
+        # not explained: the thesis's controller goes where the misfit lives, read against that element
+        h = Hypothesis("mass", localized["station"], None, f"element at station {localized['station']}", "kg",
+                       True, 0.0, math.inf, 1.0, [localized["dof"]])
+        at = Finding("mass", localized["station"], None, localized["msd"]["m"], "kg", math.inf, 0.0, 0.0,
+                     h.description, hypothesis=h)
+    if mbi and at is not none:
         tell("model-based identification at the finding (D-K iteration)", 0.97)
         try:
-            result.mbi = mbi_reading(model_text, path, verdict, chans[0].frf, chans[0].in_name,
+            result.mbi = mbi_reading(model_text, path, at, chans[0].frf, chans[0].in_name,
                                      chans[0].out_name, progress=lambda stage, frac: tell(
                                          f"model-based identification: {stage}", 0.97 + 0.02 * frac))
         except ModelError as exc:

@@ -163,6 +163,7 @@ class Diagnosis:
     fit_quality: object = None      # _fit_quality.FitQuality of the final model
     noise_reference: object = None  # _fit_quality.NoiseReference
     unmatched: dict | None = None   # resonances without a partner: {"measured": [...], "model": [...]}
+    localized: dict | None = None   # where an unexplained misfit lives (mutext.diagnose._localize)
 
     @property
     def confirmed(self) -> bool:
@@ -209,6 +210,9 @@ class Diagnosis:
             "fit_quality": None if self.fit_quality is None else self.fit_quality.as_dict(),
             "noise_reference": None if self.noise_reference is None else self.noise_reference.as_dict(),
             "unmatched_resonances": self.unmatched,
+            "localized": None if self.localized is None else {
+                k: ([[float(x.real), float(x.imag)] for x in v] if k in ("required_impedance", "msd_fit") else v)
+                for k, v in self.localized.items()},
             "findings": [f.as_dict() for f in self.findings],
             "verdict": self.verdict.as_dict(),
             "noise": self.noise,
