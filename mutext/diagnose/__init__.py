@@ -4,15 +4,41 @@ r"""Diagnosis: what a model gets wrong against measured FRFs, its cause, the fix
 :mod:`mutext.rotor.model`) and measured frequency responses
 (:class:`mutext.rig.FRF`, e.g. read with :func:`mutext.rig.read_frf`) and
 
-1. compares model and data channel by channel (the residual over frequency
-   and the measured against modelled resonances);
+1. compares model and data channel by channel (the residual over frequency,
+   the measured against modelled resonances, the measured resonances the model
+   has no partner for);
 2. tests hypotheses of the form *kind at location* -- a change of a spring,
    mass or damper, a grounded spring, mass or damper added at a mass or a
-   station, a bearing's stiffness or damping, a crack in a shaft element, the
-   exciter's force per ampere, a sensor's gain -- and **none**, fits the size
-   of each, and ranks them;
-3. writes the extended model (the original plus the identified element) and
-   measures the gain on data that the fit did not use.
+   station, a bearing's stiffness or damping, a crack in a shaft element; on
+   the measurement chain a sensor's or exciter's gain (either sign), one
+   file's scale (unit slips, named as such), a sensor's delay, a mass that
+   moves with the sensor (:mod:`~mutext.diagnose.faults.channel`); for the whole
+   structure all damping scaled and the analyser's frequency axis scaled
+   (:mod:`~mutext.diagnose.faults.structure`) -- and **none**, fits the size of
+   each, and ranks them;
+3. adds further effects by forward selection while the residual stays above
+   the noise, each with the same false-alarm control and confirmed on held-out
+   data (:mod:`mutext.diagnose._select`);
+4. tests whether what is left is the noise (:mod:`mutext.diagnose._fit_quality`)
+   and says so first: **explained**, **partly explained** or **not explained**;
+   when it is not, finds the station where the misfit lives and what it asks
+   for (:mod:`mutext.diagnose._localize`);
+5. writes the extended model (the original plus the identified elements) and
+   measures the gain on data that the fit did not use.  Only an explained
+   result is written as ``model_extended.toml``; anything else is written as
+   ``model_extended_NOT_CONFIRMED.toml``.
+
+The verdict
+-----------
+*Explained*: the final model leaves the fitted and the held-out data at the
+noise (a lack-of-fit test against a model-free noise reference with its own
+degrees of freedom) and, with an effect, does better on the held-out data
+than the engineering model.  *Partly explained*: the effects found do better on
+held-out data, but a residual above the noise remains (where, in frequency and
+by channel, is reported, and the uncertainties are inflated by the misfit).
+*Not explained*: nothing found does better on held-out data, or no effect is
+significant while the residual is above the noise.  A size at a bound of its
+range is never significant.
 
 Residual and noise
 ------------------
@@ -26,9 +52,9 @@ log ratio of model and measurement (as in :mod:`mutext.rotor.tuning`),
 For relative circular complex noise of standard deviation :math:`\sigma` (the
 virtual rig's :class:`~mutext.rig.Noise`) each real component of :math:`r`
 has variance :math:`\sigma^2/2`.  :math:`\sigma` is estimated from the data
-alone, before any model is fitted (:func:`mutext.frfit.noise_level`: robust
-fourth differences of the log response along frequency), so the tests below do not depend on the
-hypotheses being right.
+alone, before any model is fitted (model-free rational fits of each channel,
+with their degrees of freedom: :mod:`mutext.diagnose._fit_quality`), so the
+tests below do not depend on the hypotheses being right.
 
 Hypotheses and their fit
 ------------------------
@@ -112,9 +138,10 @@ References
 from ._core import HOLDOUT_EVERY, diagnose
 from ._extend import extended_model_text, mbi_reading, write_model
 from ._hypotheses import KINDS, Hypothesis, hypotheses
-from ._result import ChannelComparison, Diagnosis, Finding, ResonanceRow
+from ._result import UNIT_SLIPS, ChannelComparison, Diagnosis, Finding, ResonanceRow
+from . import faults
 from ._sidebands import SidebandCandidate, SidebandEvidence, sideband_evidence
 
 __all__ = ["diagnose", "Diagnosis", "Finding", "Hypothesis", "ChannelComparison", "ResonanceRow",
            "hypotheses", "extended_model_text", "write_model", "mbi_reading", "KINDS", "HOLDOUT_EVERY",
-           "sideband_evidence", "SidebandEvidence", "SidebandCandidate"]
+           "sideband_evidence", "SidebandEvidence", "SidebandCandidate", "UNIT_SLIPS", "faults"]
