@@ -163,7 +163,13 @@ def _diagnose(model, frfs, validate, alpha, refit, noise, out_dir, progress, onl
 
     # 3. goodness of fit; further effects while the residual stays above the noise
     effects = [] if verdict is none else [verdict]
-    effects, quality = _select_more(effects, hyps, rec, fit, held, s2, N, threshold, alpha, ref, notes, tell)
+    first = None
+    if _in_model_file(verdict):
+        # the model file with the finding is what the user receives (with modal damping its damping follows
+        # the change, which the screen holds fixed): judged on its own responses
+        first = _quality_of_file(verdict, model_text, eng, path, rec, chans, all_fit, held, s2, ref, alpha)
+    effects, quality = _select_more(effects, hyps, rec, fit, held, s2, N, threshold, alpha, ref, notes, tell,
+                                    first)
     if len(effects) > 1:
         verdict = effects[0]
 
@@ -180,6 +186,8 @@ def _diagnose(model, frfs, validate, alpha, refit, noise, out_dir, progress, onl
         after_held = Compound(rec, held, comp[0]).responses(comp[1])
     else:
         after_all, after_held = _after(verdict, text, path, rec, chans, all_fit, held)
+        if _in_model_file(verdict):
+            quality = first
     err_before = _errors(held.H0, held.meas)
     err_after = _errors(after_held, held.meas)
     gain = err_before["rel"] / err_after["rel"] if err_after["rel"] > 0 else math.inf
@@ -201,7 +209,7 @@ def _diagnose(model, frfs, validate, alpha, refit, noise, out_dir, progress, onl
             e.std *= infl
         notes.append(f"the residual is above the noise: the effects' uncertainties are inflated by "
                      f"sqrt(misfit) = {infl:.3g}")
-    if effects and not gain > 1:
+    if effects and status == "not explained" and not gain > 1:
         notes.append(f"the extended model fits the held-out data worse than the engineering model "
                      f"(gain {gain:.3g}x): it is not a fix")
     localized = None
@@ -214,7 +222,8 @@ def _diagnose(model, frfs, validate, alpha, refit, noise, out_dir, progress, onl
     result = Diagnosis(eng.name, path, noise, findings, verdict, ambiguous, sensor, err_before, err_after, gain,
                        held_desc, comps, rows, summary, threshold, alpha, len(hyps), text,
                        time.perf_counter() - t0, notes, N, status=status, effects=effects, fit_quality=quality,
-                       noise_reference=ref, unmatched=unmatched, localized=localized)
+                       noise_reference=ref, unmatched=unmatched, localized=localized,
+                       held_quality=held_quality)
     if speed > 0 and hasattr(eng, "n_stations"):
         # where to look: the modes of the best time-invariant model (a mode the engineering model misplaces
         # is not a sideband)
@@ -427,8 +436,25 @@ def _status(effects, quality, gain, held_quality) -> str:
     return "partly explained" if (effects and better) else "not explained"
 
 
-def _select_more(effects, hyps, rec, fit, held, s2, N, threshold, alpha, ref, notes, tell):
-    """Forward selection (see :mod:`mutext.diagnose._select`): returns (effects, fit quality of the last model)."""
+def _in_model_file(f) -> bool:
+    """Whether a finding is a structural change written into the model file (not a correction of the data)."""
+    h = f.hypothesis
+    return f.kind != "none" and h is not None and h.gain is None and h.glob is None
+
+
+def _quality_of_file(verdict, model_text, eng, path, rec, chans, all_fit, held, s2, ref, alpha):
+    """The lack-of-fit test of the extended model file itself, on every fitted line."""
+    text = extended_model_text(model_text, verdict, eng)
+    after_all, _ = _after(verdict, text, path, rec, chans, all_fit, held)
+    with np.errstate(all="ignore"):
+        r = [np.log(h / m) for h, m in zip(after_all, all_fit.meas)]
+    return fit_quality(r, all_fit.freq_hz, [c.label for c in all_fit.chans], s2, 1, ref, alpha)
+
+
+def _select_more(effects, hyps, rec, fit, held, s2, N, threshold, alpha, ref, notes, tell, first=None):
+    """Forward selection (see :mod:`mutext.diagnose._select`): returns (effects, fit quality of the last model).
+
+    ``first``: the fit quality of the first effect when it is judged on the model file itself."""
     labels = [c.label for c in fit.chans]
 
     def quality_of(effs, thetas):
@@ -438,7 +464,7 @@ def _select_more(effects, hyps, rec, fit, held, s2, N, threshold, alpha, ref, no
         return fit_quality(r, fit.freq_hz, labels, s2, len(effs), ref, alpha)
 
     thetas = [e.value for e in effects]
-    quality = quality_of(effects, thetas)
+    quality = first if first is not None else quality_of(effects, thetas)
     chi_held = float(sst.chi2.isf(alpha, 1))
     while effects and not quality.at_noise and len(effects) < MAX_EFFECTS:
         tell(f"the residual is above the noise: screening a further effect given {len(effects)}", 0.9)

@@ -43,7 +43,7 @@ wrong.  The lag-1 autocorrelation :math:`r_1` of the noise reference's
 residual (pooled over channels) is measured; when it is significant
 (:math:`|r_1| > 2/\sqrt{n}`), both degrees of freedom are divided by the
 variance inflation of a sum of squares of a first-order correlated sequence,
-:math:`(1 + r_1^2)/(1 - r_1^2)` (a Hann window's :math:`|r_1| = 2/3`: 1.9).
+:math:`(1 + r_1^2)/(1 - r_1^2)` (a Hann window's :math:`|r_1| = 2/3`: 2.6).
 A stepped-sine sweep has independent lines (:math:`r_1 \approx 0`).  Noise
 given by the user (``noise=``, e.g. from repeated sweeps) is taken as exact
 (:math:`\nu = \infty`).

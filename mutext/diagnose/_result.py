@@ -164,6 +164,7 @@ class Diagnosis:
     noise_reference: object = None  # _fit_quality.NoiseReference
     unmatched: dict | None = None   # resonances without a partner: {"measured": [...], "model": [...]}
     localized: dict | None = None   # where an unexplained misfit lives (mutext.diagnose._localize)
+    held_quality: object = None     # the lack-of-fit test of the final model on the held-out data
 
     @property
     def confirmed(self) -> bool:
@@ -188,6 +189,11 @@ class Diagnosis:
             return (f"PARTLY EXPLAINED: {eff} helps (held-out gain {self.gain:.3g}x) but {left}; "
                     f"uncertainties are inflated by the misfit, and the cause may lie beyond the hypotheses")
         why = []
+        hq = self.held_quality
+        if q is not None and q.at_noise and hq is not None and not hq.at_noise:
+            why.append(f"the fitted data are at the noise but the held-out data are not ({hq.misfit:.3g} times the "
+                       f"noise, at most {hq.limit:.3g}: {hq.where()})")
+            left = ""
         if self.effects and not self.gain > 1:
             why.append(f"the best hypotheses ({eff}) make held-out data worse (gain {self.gain:.3g}x)")
         elif self.effects:
@@ -208,6 +214,7 @@ class Diagnosis:
             "effects": [f.as_dict() for f in self.effects],
             "confirmed": self.confirmed,
             "fit_quality": None if self.fit_quality is None else self.fit_quality.as_dict(),
+            "held_out_quality": None if self.held_quality is None else self.held_quality.as_dict(),
             "noise_reference": None if self.noise_reference is None else self.noise_reference.as_dict(),
             "unmatched_resonances": self.unmatched,
             "localized": None if self.localized is None else {
