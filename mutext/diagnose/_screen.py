@@ -8,6 +8,7 @@ import numpy as np
 
 from ._channels import _Chan
 from ._hypotheses import Hypothesis
+from .faults._base import local_change
 from .faults import channel as _channel
 from .faults import structure as _structure
 
@@ -86,12 +87,7 @@ class _Evaluator:
             self.pieces.append((y, z, RUU, w))
 
     def _D(self, w, theta):
-        h = self.hyp
-        if h.crack is not None:
-            dK = h.crack(theta)
-            return np.broadcast_to(dK, (w.size,) + dK.shape).astype(complex)
-        s = (np.ones_like(w), 1j * w, -w * w)[h.order]
-        return s[:, None, None] * h.pattern[None]
+        return local_change(self.hyp, theta, w)
 
     def responses(self, theta: float, derivative: bool = False):
         """Per channel ``H(theta)`` (and ``dH/dtheta`` when asked)."""

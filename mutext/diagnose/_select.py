@@ -32,6 +32,7 @@ import scipy.optimize as so
 
 from ._screen import _Data, _Receptance
 from .faults import channel as _channel
+from .faults._base import local_change
 from .faults import structure as _structure
 
 #: Largest number of effects forward selection accepts.
@@ -69,11 +70,7 @@ class Compound:
             if h.gain is not None or h.glob is not None:
                 continue
             E = self.embed[id(h)]
-            if h.crack is not None:
-                D += (E @ np.asarray(h.crack(t)) @ E.T)[None]
-            else:
-                s = (np.ones_like(w), 1j * w, -w * w)[h.order]
-                D += (t * s)[:, None, None] * (E @ h.pattern @ E.T)[None]
+            D += E[None] @ local_change(h, t, w) @ E.T[None]
         return D
 
     def responses(self, thetas) -> list:

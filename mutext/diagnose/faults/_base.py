@@ -69,3 +69,14 @@ class Hypothesis:
     @property
     def label(self) -> str:
         return f"{self.kind} at {self.station}" + (f" ({self.element})" if self.element else "")
+
+
+def local_change(h: Hypothesis, theta: float, w) -> np.ndarray:
+    """The change of dynamic stiffness of a local hypothesis on its DOFs at size ``theta``, per frequency:
+    ``(w.size, |U|, |U|)`` (a crack's exact stiffness change, else ``theta (1, j w, -w^2)[order] S``)."""
+    w = np.asarray(w, float)
+    if h.crack is not None:
+        dK = np.asarray(h.crack(theta))
+        return np.broadcast_to(dK, (w.size,) + dK.shape).astype(complex)
+    s = (np.ones_like(w), 1j * w, -w * w)[h.order]
+    return (theta * s)[:, None, None] * h.pattern[None]

@@ -27,7 +27,7 @@ import re
 import numpy as np
 
 from ...errors import ModelError
-from ._base import Hypothesis
+from ._base import Hypothesis, local_change
 
 KINDS = ("damping_scale", "frequency_scale")
 
@@ -63,11 +63,7 @@ def responses(rec, data, hyps: list, thetas: list) -> list:
             if h.gain is not None or h.glob is not None:
                 continue
             U = np.asarray(h.dofs)
-            if h.crack is not None:
-                Z[:, U[:, None], U[None, :]] += np.asarray(h.crack(t))[None]
-            else:
-                sw = (np.ones_like(w), 1j * w, -w * w)[h.order]
-                Z[:, U[:, None], U[None, :]] += t * sw[:, None, None] * h.pattern[None]
+            Z[:, U[:, None], U[None, :]] += local_change(h, t, w)
         if moving:                          # a mass that moves with the sensor: at this group's output
             o = data.chans[ks[0]].out_dof
             Z[:, o, o] += -w * w * sum(moving)
