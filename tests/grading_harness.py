@@ -4,7 +4,7 @@ import threading
 from concurrent.futures import ThreadPoolExecutor
 from pathlib import Path
 
-from mutext.grading import grade
+from mutext_grader import grade
 
 ROOT = Path(__file__).resolve().parents[1]
 SUBS = Path(__file__).resolve().parent / "grading_submissions"
@@ -18,7 +18,7 @@ class GradedSubmissions:
         self.timeout = timeout
         prefix = exercise.split("_")[0]
         self.paths = {
-            "reference": ROOT / "mutext" / "grading" / "solutions" / f"{exercise}.py",
+            "reference": ROOT / "instructor" / "mutext_grader" / "solutions" / f"{exercise}.py",
             "stub": ROOT / "exercises" / f"{exercise}.py",
             **{p.stem: p for p in SUBS.glob(f"{prefix}_*.py")},
         }

@@ -23,12 +23,12 @@ from pathlib import Path
 import pytest
 
 from grading_harness import ROOT
-from mutext.grading import core
-from mutext.grading.cli import NOT_ISOLATED, main as grade_main
+from mutext_grader import core
+from mutext_grader.cli import NOT_ISOLATED, main as grade_main
 
 GRADESCOPE = ROOT / "docs" / "gradescope"
 HOSTILE = ROOT / "tests" / "grading_submissions" / "hostile"
-SOLUTION = ROOT / "mutext" / "grading" / "solutions" / "ex03_free_decay.py"
+SOLUTION = ROOT / "instructor" / "mutext_grader" / "solutions" / "ex03_free_decay.py"
 IS_ROOT = hasattr(os, "geteuid") and os.geteuid() == 0
 
 
@@ -97,7 +97,7 @@ def test_gradescope_layout_end_to_end():
         ref = run(SOLUTION)
         assert ref["score"] == 10 and ref["isolation"] == "uid", ref["output"]
         borrow = base / "borrow.py"
-        borrow.write_text("from mutext.grading.solutions.ex03_free_decay import *\n")
+        borrow.write_text("from mutext_grader.solutions.ex03_free_decay import *\n")
         for f in sorted(HOSTILE.glob("ex03_*.py")) + [borrow]:
             res = run(f)
             assert res["score"] == 0, (f.name, res["output"])

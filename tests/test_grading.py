@@ -14,10 +14,10 @@ import numpy as np
 import pytest
 
 from mutext import cli
-from mutext.grading import GradingError, cli_grade, grade
-from mutext.grading import ex01_two_mass_hinf as ex01
+from mutext_grader import GradingError, cli_grade, grade
+from mutext_grader import ex01_two_mass_hinf as ex01
 from mutext.grading.sandbox import _Events
-from mutext.grading.solutions import ex01_two_mass_hinf as sol
+from mutext_grader.solutions import ex01_two_mass_hinf as sol
 
 ROOT = Path(__file__).resolve().parents[1]
 SUBS = Path(__file__).resolve().parent / "grading_submissions"
@@ -25,7 +25,7 @@ EXERCISE = "ex01_two_mass_hinf"
 LOOP_LIMIT = 8.0   # seconds per question for the endless-loop submission
 
 SUBMISSIONS = {
-    "reference": ROOT / "mutext" / "grading" / "solutions" / "ex01_two_mass_hinf.py",
+    "reference": ROOT / "instructor" / "mutext_grader" / "solutions" / "ex01_two_mass_hinf.py",
     "stub": ROOT / "exercises" / "ex01_two_mass_hinf.py",
     # ex01 submissions have no exNN_ prefix; the other exercises' submissions do
     **{p.stem: p for p in SUBS.glob("*.py") if not re.match(r"ex\d\d_", p.stem)},
@@ -163,7 +163,7 @@ def test_reading_the_reference_is_blocked_and_reported():
     assert "integrity violation" in a.output and "importing mutext.examples" in a.output
     # the attempt was caught by the submission and an honest plant returned: still 0
     assert "opening" in b.output and "solutions/ex01_two_mass_hinf.py" in b.output
-    assert "importing mutext.grading" in c.output
+    assert "importing mutext_grader" in c.output
     assert all(x.status == "violation" for x in (a, b, c))
     assert full(rep, "d")
 
@@ -171,8 +171,8 @@ def test_reading_the_reference_is_blocked_and_reported():
 def test_module_level_violation_zeroes_everything():
     rep = graded("cheat_at_import")
     assert rep.score == 0
-    assert any("importing mutext.grading" in n for n in rep.notes)
-    assert all("integrity violation when the file was imported (importing mutext.grading)" in x.output
+    assert any("importing mutext_grader" in n for n in rep.notes)
+    assert all("integrity violation when the file was imported (importing mutext_grader)" in x.output
                for x in rep.questions)
 
 
@@ -293,7 +293,7 @@ def test_cli_list_through_main_dispatch(capsys):
 
 
 def test_fmt_shows_nan_and_inf_as_real_numbers():
-    from mutext.grading.compare import fmt
+    from mutext_grader.compare import fmt
     assert fmt(float("nan")) == "nan" and fmt(np.nan) == "nan"
     assert fmt(float("inf")) == "inf" and fmt(-np.inf) == "-inf"
     assert fmt(2.0) == "2" and fmt(1 + 2j) == "1+2j" and fmt(0.0) == "0"

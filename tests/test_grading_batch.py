@@ -18,15 +18,15 @@ import pytest
 from grading_harness import ROOT, SUBS
 
 from mutext.cli import main
-from mutext.grading import GradingError
-from mutext.grading import batch as gbatch
+from mutext_grader import GradingError
+from mutext_grader import batch as gbatch
 from mutext.grading._jail import landlock_abi
 
 IS_ROOT = hasattr(os, "geteuid") and os.geteuid() == 0
 ABI = landlock_abi() if sys.platform.startswith("linux") else 0
 
 FILES = {
-    "reference.py": ROOT / "mutext" / "grading" / "solutions" / "ex03_free_decay.py",
+    "reference.py": ROOT / "instructor" / "mutext_grader" / "solutions" / "ex03_free_decay.py",
     "ex03_hz.py": SUBS / "ex03_hz.py",
     "hostile_read_path.py": SUBS / "hostile" / "ex03_read_path.py",
     "cheat_at_import.py": SUBS / "cheat_at_import.py",
@@ -81,7 +81,7 @@ def test_hostile_and_cheating_submissions_score_zero_and_are_recorded(graded):
     assert "could not be imported" in hostile["problems"]
     cheat = rows["cheat_at_import.py"]
     assert float(cheat["score"]) == 0
-    assert "integrity violation" in cheat["integrity"] and "mutext.grading" in cheat["integrity"]
+    assert "integrity violation" in cheat["integrity"] and "mutext_grader" in cheat["integrity"]
     syntax = rows["syntax_error.py"]
     assert float(syntax["score"]) == 0 and "SyntaxError" in syntax["problems"]
     # the batch went on past them: the files after them in the order were graded too

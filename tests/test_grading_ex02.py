@@ -10,8 +10,8 @@ import pytest
 
 from grading_harness import ROOT, GradedSubmissions, full, q
 from mutext import cli
-from mutext.grading import ex02_mu as ex02
-from mutext.grading.solutions import ex02_mu as sol
+from mutext_grader import ex02_mu as ex02
+from mutext_grader.solutions import ex02_mu as sol
 
 EXERCISE = "ex02_mu"
 SP = "M = [[2, 2], [-1, -1]] (Skogestad & Postlethwaite, example 8.5)"

@@ -11,9 +11,9 @@ import pytest
 
 from grading_harness import ROOT, GradedSubmissions, full, q
 from mutext import cli
-from mutext.grading import ex03_free_decay as ex03
-from mutext.grading import grade
-from mutext.grading.solutions import ex03_free_decay as sol
+from mutext_grader import ex03_free_decay as ex03
+from mutext_grader import grade
+from mutext_grader.solutions import ex03_free_decay as sol
 
 EXERCISE = "ex03_free_decay"
 graded = GradedSubmissions(EXERCISE)

@@ -11,8 +11,8 @@ import pytest
 
 from grading_harness import ROOT, GradedSubmissions, full, q
 from mutext import cli
-from mutext.grading import ex04_beam_element as ex04
-from mutext.grading.solutions import ex04_beam_element as sol
+from mutext_grader import ex04_beam_element as ex04
+from mutext_grader.solutions import ex04_beam_element as sol
 
 EXERCISE = "ex04_beam_element"
 graded = GradedSubmissions(EXERCISE)

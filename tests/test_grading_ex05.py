@@ -3,7 +3,7 @@ import numpy as np
 import pytest
 
 from grading_harness import GradedSubmissions, full, q
-from mutext.grading import ex05_diagnose as ex05
+from mutext_grader import ex05_diagnose as ex05
 
 graded = GradedSubmissions("ex05_diagnose")
 

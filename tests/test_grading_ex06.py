@@ -3,7 +3,7 @@ import numpy as np
 import pytest
 from grading_harness import GradedSubmissions, full, q
 
-from mutext.grading import ex06_sidebands as ex06
+from mutext_grader import ex06_sidebands as ex06
 
 graded = GradedSubmissions("ex06_sidebands")
 

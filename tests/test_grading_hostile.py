@@ -27,7 +27,8 @@ from pathlib import Path
 import pytest
 
 from grading_harness import ROOT, q
-from mutext.grading import GradingError, cli_grade, grade, sandbox
+from mutext.grading import sandbox
+from mutext_grader import GradingError, cli_grade, grade
 from mutext.grading._jail import landlock_abi
 from mutext.grading.sandbox import Job, run_submission
 
@@ -50,7 +51,7 @@ def graded(name):
     with _lock:
         if not _futures:
             _futures["reference"] = _pool.submit(grade, "ex03_free_decay",
-                                                 ROOT / "mutext" / "grading" / "solutions" / "ex03_free_decay.py")
+                                                 ROOT / "instructor" / "mutext_grader" / "solutions" / "ex03_free_decay.py")
             for n in sorted(SUBMISSIONS, key=lambda n: n != "ex03_forge_events"):
                 limit = FORGE_LIMIT if n == "ex03_forge_events" else 60.0
                 _futures[n] = _pool.submit(grade, EXERCISES[n[:4]], SUBMISSIONS[n], limit)
@@ -61,7 +62,7 @@ def _marker_paths():
     dirs = {sysconfig.get_paths()["purelib"], *__import__("site").getsitepackages(), os.path.expanduser("~root"),
             os.path.expanduser("~"), "/tmp", "/var/tmp", "/dev/shm"}
     return [Path(d) / (MARK + ".pth") for d in dirs] + [Path(d) / MARK for d in dirs] + [
-        ROOT / "mutext" / "grading" / (MARK + ".py")]
+        ROOT / "mutext" / "grading" / (MARK + ".py"), ROOT / "instructor" / "mutext_grader" / (MARK + ".py")]
 
 
 # ----------------------------------------------------------------------------
@@ -90,7 +91,7 @@ def test_hostile_submission_scores_zero(name):
 @pytest.mark.parametrize("name", ["ex01_frames", "ex03_frames", "ex04_frames", "ex03_gc"])
 def test_switching_off_the_audit_hook_does_not_reach_the_solutions(name):
     rep = graded(name)
-    assert all("No module named 'mutext.grading'" in x.output for x in rep.questions), rep.text()
+    assert all("No module named 'mutext_grader'" in x.output for x in rep.questions), rep.text()
 
 
 @pytest.mark.parametrize("name", ["ex03_read_path", "ex03_importlib_path"])
@@ -152,7 +153,8 @@ def _probe():
         import probe
     finally:
         sys.path.remove(str(HOSTILE))
-    args = [str(ROOT / "mutext" / "grading" / "solutions" / "ex03_free_decay.py"), str(ROOT / "mutext" / "grading"),
+    args = [str(ROOT / "instructor" / "mutext_grader" / "solutions" / "ex03_free_decay.py"),
+            str(ROOT / "instructor" / "mutext_grader"),
             str(ROOT), sysconfig.get_paths()["purelib"], os.path.expanduser("~"), str(ROOT / "mutext")]
     res = run_submission(HOSTILE / "probe.py", [Job("p", "probe", "array", [{"args": args}])], time_limit=60)
     call = res.questions["p"].calls[0]
@@ -191,7 +193,7 @@ def test_a_run_that_is_not_isolated_says_so(monkeypatch, capsys):
     assert worked["read the solution"] == 1
     assert res.isolation == "none"
     assert any("could read" in d and "ex03_free_decay.py" in d for d in res.isolation_details)
-    ref = ROOT / "mutext" / "grading" / "solutions" / "ex03_free_decay.py"
+    ref = ROOT / "instructor" / "mutext_grader" / "solutions" / "ex03_free_decay.py"
     assert cli_grade(["ex03", str(ref), "--json"]) == 0
     data = json.loads(capsys.readouterr().out)
     assert data["isolation"] == "none" and "NOT isolated" in data["output"] and data["score"] == 10
@@ -201,7 +203,7 @@ def test_a_run_that_is_not_isolated_says_so(monkeypatch, capsys):
 def test_root_without_namespace_or_landlock_never_claims_isolation(monkeypatch):
     """Fails closed: either the child cannot even start as nobody, or the report says "none"."""
     monkeypatch.setattr(sandbox, "SKIP", ("namespaces", "landlock"))
-    ref = ROOT / "mutext" / "grading" / "solutions" / "ex03_free_decay.py"
+    ref = ROOT / "instructor" / "mutext_grader" / "solutions" / "ex03_free_decay.py"
     try:
         rep = grade("ex03", ref)
     except GradingError as exc:
@@ -217,7 +219,7 @@ def test_root_without_namespace_or_landlock_never_claims_isolation(monkeypatch):
 
 @pytest.mark.parametrize("value", ["nan", "-1", "0", "inf"])
 def test_time_limit_must_be_a_positive_number(value, capsys):
-    ref = ROOT / "mutext" / "grading" / "solutions" / "ex03_free_decay.py"
+    ref = ROOT / "instructor" / "mutext_grader" / "solutions" / "ex03_free_decay.py"
     assert cli_grade(["ex03", str(ref), "--time-limit", value]) == 2
     assert "--time-limit must be a positive number of seconds" in capsys.readouterr().err
     with pytest.raises(GradingError, match="positive number of seconds"):
@@ -250,11 +252,13 @@ def test_package_only_on_pythonpath(tmp_path):
     """A copy of the package on PYTHONPATH (not installed) grades, and its solutions stay out of reach."""
     src = tmp_path / "src"
     shutil.copytree(ROOT / "mutext", src / "mutext", ignore=shutil.ignore_patterns("__pycache__"))
+    shutil.copytree(ROOT / "instructor" / "mutext_grader", src / "mutext_grader",
+                    ignore=shutil.ignore_patterns("__pycache__"))
     code = ("import sys, mutext, mutext.cli; print(mutext.__file__); "
             "sys.exit(mutext.cli.main(['grade', 'ex03', sys.argv[1]]))")
     env = {k: v for k, v in os.environ.items() if not k.startswith("PYTHON")}
     env["PYTHONPATH"] = str(src)
-    for sub, total in ((src / "mutext" / "grading" / "solutions" / "ex03_free_decay.py", "Total: 10.00 / 10"),
+    for sub, total in ((src / "mutext_grader" / "solutions" / "ex03_free_decay.py", "Total: 10.00 / 10"),
                        (HOSTILE / "ex03_read_path.py", "Total: 0.00 / 10")):
         out = subprocess.run([sys.executable, "-c", code, str(sub)], cwd=tmp_path, env=env, capture_output=True,
                              text=True, timeout=300)

@@ -22,8 +22,8 @@ REPO = HERE.parents[1]
 
 
 def build(exercise: str, out: Path) -> Path:
-    sys.path.insert(0, str(REPO))
-    from mutext.grading.core import GradingError, get_exercise
+    sys.path.insert(0, str(REPO / "instructor"))
+    from mutext_grader.core import GradingError, get_exercise
     try:
         name = get_exercise(exercise).name
     except GradingError as exc:

@@ -1,81 +1,36 @@
-"""Offline autograder for the exercises in ``exercises/``.
+"""Running a student's file confined, and checking it locally.
 
-``mutext grade EXERCISE SUBMISSION [--json] [--output results.json]`` scores a
-student's file and prints per-question points with feedback; ``--json``
-writes the Gradescope ``results.json`` schema instead (``{"score": ...,
-"tests": [{"name", "score", "max_score", "output"}, ...]}``).  No network,
-no containers.  ``mutext grade EXERCISE DIR [--jobs N]`` grades every
-``*.py`` file in a directory, each as one, and writes a results file per
-submission and a class ``summary.csv`` (:mod:`mutext.grading.batch`).
+The grader itself (reference solutions, graded inputs, answers and scores)
+is the instructor's distribution ``mutext-grader`` (package
+``mutext_grader``, in the repository's ``instructor/`` directory); it is not
+installed with ``mutext``, so nothing a student installs holds an answer.
+What is here is public:
 
-How a submission is run
------------------------
-The submission is copied to a private temporary directory and imported in a
-child process (:mod:`mutext.grading.sandbox`, :mod:`mutext.grading._jail`,
-:mod:`mutext.grading._runner`) that only calls the student's functions on
-given inputs and sends back plain matrices and numbers (JSON, validated on
-arrival).  The child holds no reference answers and no solution code; all
-scores are computed in the grading process from those numbers: models are
-compared through their frequency responses, a controller is closed around
-the reference plant here.  The importing and each question have a
-wall-clock time limit; a question that hangs or crashes scores 0 and the
-remaining questions run in a fresh child.
-
-Isolation
----------
-The rules are enforced by the kernel, outside the student's interpreter:
-
-* as root (a Gradescope or CI container), the child runs as the user
-  ``nobody`` in its own mount and network namespaces, where the package,
-  the source checkout, ``/root``, ``/home`` and the temporary directories
-  are empty except for the Python installation and the child's own
-  directory (``isolation: uid`` in the report);
-* for everyone, where the kernel offers them, Landlock (read only Python,
-  the system and the child's own files; write only its directory; no TCP)
-  and a seccomp filter (no new processes); a plain user gets
-  ``isolation: landlock``;
-* resource limits: memory (address space), CPU time, file size, processes.
-
-The child checks from the inside that it cannot read the solutions nor
-write into site-packages; if it can, or nothing could be applied (macOS,
-an old kernel), the report says ``isolation: none``.  Grade a course as root
-in a container (``docs/grading.md``).
-
-Before the submission is imported the child also installs an audit hook
-that reports the usual attempts (importing ``mutext.grading``,
-``mutext.examples``, ``mutext.demos`` or an exercise's blocked module such
-as :mod:`mutext.rotor` for ex04, opening their files, starting processes,
-loading native code with :mod:`ctypes`) as integrity violations: one inside
-a question's function scores that question 0, one at import time every
-question.  Students may use numpy, scipy, control, :mod:`mutext.lti` and
-:mod:`mutext.hinf`.  The hook only names the attempt; what blocks it is the
-isolation above.
-
-Modules
--------
-core
-    Exercises, questions, :func:`grade` and reports.
-sandbox
-    The child process, its isolation and its time limits.
-compare
-    Frequency-response comparison with feedback per channel.
-batch
-    A directory of submissions: results per file, ``summary.csv``, parallel workers.
-ex01_two_mass_hinf
-    Grader of the first exercise.
-ex04_beam_element
-    Grader of the beam-element exercise (numpy only; :mod:`mutext.rotor` is blocked).
-solutions
-    Reference solutions (each one a full-marks submission).
+sandbox, _jail, _runner
+    The confined child process that imports a submission and calls its
+    functions (kernel isolation: user switch, mount namespace, Landlock,
+    seccomp, resource limits), used by the grader.
+check
+    ``mutext check EXERCISE FILE``: runs a student's file on freshly drawn
+    inputs and says whether each function runs and returns a value of the
+    right kind and shape. It never computes or prints reference values.
 """
 from __future__ import annotations
 
-from .core import EXERCISES, GradingError, Report, get_exercise, grade
-
-__all__ = ["grade", "cli_grade", "Report", "GradingError", "EXERCISES", "get_exercise"]
+__all__ = ["cli_grade"]
 
 
 def cli_grade(argv) -> int:
-    """``mutext grade ...``; returns the exit code (0 once grading completed, 2 on misuse)."""
-    from .cli import main
-    return main(argv)
+    """``mutext grade ...``: the instructor's grader if it is installed, else a pointer to ``mutext check``."""
+    import sys
+    try:
+        from mutext_grader import cli_grade as grader_cli
+    except ImportError:
+        print("mutext grade: the grader is the instructor's package (mutext-grader: reference solutions and "
+              "graded inputs), which is not installed with mutext.\n"
+              "  students: check that your file runs and returns the right kinds of values with\n"
+              "            mutext check EXERCISE FILE   (mutext check --list shows the exercises)\n"
+              "  instructors: pip install ./instructor from the mutext repository (docs/grading.md)",
+              file=sys.stderr)
+        return 2
+    return grader_cli(argv)

@@ -65,12 +65,29 @@ JAIL = Path(__file__).with_name("_jail.py")
 PACKAGE_ROOT = Path(__file__).resolve().parents[1]          # .../mutext
 #: a source checkout (its git history and tests hold answers too), or None for an installed package
 CHECKOUT = PACKAGE_ROOT.parent if (PACKAGE_ROOT.parent / "pyproject.toml").is_file() else None
+
+
+def _grader_dir():
+    """Where the instructor's grader (``mutext_grader``: the reference solutions and answers) is, found
+    without importing it, or None (a student's installation has no grader)."""
+    import importlib.util
+    try:
+        spec = importlib.util.find_spec("mutext_grader")
+    except (ImportError, ValueError):
+        return None
+    if spec is None or not spec.submodule_search_locations:
+        return None
+    return Path(list(spec.submodule_search_locations)[0]).resolve()
+
+
+#: the instructor's grader package (reference solutions, answer computation), or None
+GRADER_DIR = _grader_dir()
 #: directories whose files hold answers (the grader, its solutions, the example models)
-PROTECTED_DIRS = [Path(__file__).resolve().parent, PACKAGE_ROOT / "examples", PACKAGE_ROOT / "demos"]
+PROTECTED_DIRS = [PACKAGE_ROOT / "examples", PACKAGE_ROOT / "demos"] + ([GRADER_DIR] if GRADER_DIR else [])
 if CHECKOUT is not None:
     PROTECTED_DIRS += [CHECKOUT / ".git", CHECKOUT / "tests"]
 #: modules a submission may not import (they contain or compute the answers)
-PROTECTED_MODULES = ["mutext.grading", "mutext.examples", "mutext.demos"]
+PROTECTED_MODULES = ["mutext_grader", "mutext.grading", "mutext.examples", "mutext.demos"]
 #: parts of the package never copied into the child's ``lib`` (``data`` holds the rig's parameters)
 UNSTAGED = ("grading", "examples", "demos", "data")
 #: time allowed for the child to start Python and import numpy/scipy/control
@@ -158,7 +175,7 @@ def _under(p: str, d: str) -> bool:
 
 def _secret_roots() -> list:
     """Directories the child must not read at all: the real package and the source checkout."""
-    roots = [_real(PACKAGE_ROOT)]
+    roots = [_real(PACKAGE_ROOT)] + ([_real(GRADER_DIR)] if GRADER_DIR else [])
     if CHECKOUT is not None:
         roots.append(_real(CHECKOUT))
     return roots
@@ -183,7 +200,7 @@ def _allowed_path(p: str) -> bool:
     """A ``sys.path`` entry the child may read: not in the package, not the checkout or above it (a venv
     inside the checkout is fine; a directory that holds the package beside libraries is read without it)."""
     r = _real(p)
-    if r == "/" or _under(r, _real(PACKAGE_ROOT)):
+    if r == "/" or _under(r, _real(PACKAGE_ROOT)) or (GRADER_DIR and _under(r, _real(GRADER_DIR))):
         return False
     if CHECKOUT is not None:
         checkout = _real(CHECKOUT)
@@ -238,8 +255,10 @@ def _probe_files(extra_modules) -> list:
     """Files the child must not be able to read: the solutions, the grader, answer-holding modules."""
     out = []
     grading = Path(__file__).resolve().parent
-    out += sorted(str(p) for p in (grading / "solutions").glob("*.py"))
-    out += [str(grading / "core.py"), str(grading / "_runner.py"), str(PACKAGE_ROOT / "__init__.py")]
+    if GRADER_DIR is not None:
+        out += sorted(str(p) for p in (GRADER_DIR / "solutions").glob("*.py"))
+        out += [str(GRADER_DIR / "core.py")]
+    out += [str(grading / "_runner.py"), str(PACKAGE_ROOT / "__init__.py")]
     out += sorted(str(p) for p in (PACKAGE_ROOT / "examples").glob("*.py"))[:3]
     out += sorted(str(p) for p in (PACKAGE_ROOT / "data").glob("*"))[:3]
     for m in extra_modules:
@@ -255,6 +274,7 @@ def _probe_dirs(workdir) -> list:
     """Directories the child must not be able to write: site-packages, the grader's home and files."""
     out = [sysconfig.get_paths().get("purelib", ""), sysconfig.get_paths().get("platlib", ""),
            sys.prefix, str(PACKAGE_ROOT), str(Path(__file__).resolve().parent), str(workdir),
+           *([str(GRADER_DIR)] if GRADER_DIR else []),
            os.path.expanduser("~"), tempfile.gettempdir()]
     if CHECKOUT is not None:
         out.append(str(CHECKOUT))

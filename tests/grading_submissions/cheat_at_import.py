@@ -1,6 +1,6 @@
 """Submission that imports the grader at module level (blocked; the whole file scores 0)."""
 try:
-    import mutext.grading as _grader
+    import mutext_grader as _grader
 except Exception:
     _grader = None
 import numpy as np

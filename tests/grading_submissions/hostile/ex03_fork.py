@@ -14,7 +14,8 @@ def _grader_dir():
     return "/work/main/mutext/grading"
 
 
-SOLUTION = os.path.join(_grader_dir(), "solutions", "ex03_free_decay.py")
+SOLUTION = os.path.join(os.path.dirname(os.path.dirname(_grader_dir())), "instructor", "mutext_grader", "solutions",
+                        "ex03_free_decay.py")
 
 
 def _disarm():

@@ -7,4 +7,4 @@ _g = _f.f_locals["guard"]
 _g.blocked = []
 _g.modules = ()
 _g.phase = None
-from mutext.grading.solutions.ex03_free_decay import *  # noqa: E402,F401,F403
+from mutext_grader.solutions.ex03_free_decay import *  # noqa: E402,F401,F403

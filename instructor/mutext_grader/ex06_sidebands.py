@@ -71,7 +71,7 @@ def _cached(key, make):
     Two gradings may run in threads of one process (the tests do): the lock keeps them from making
     the same sweep twice, and one BLAS thread keeps the eigenvalue solvers from spinning against each
     other on a busy machine (:func:`mutext.lti.blas_single_thread`)."""
-    from ..lti import blas_single_thread
+    from mutext.lti import blas_single_thread
     with _LOCK:
         if key not in _CACHE:
             with blas_single_thread():
@@ -80,7 +80,7 @@ def _cached(key, make):
 
 
 def _make_model(name):
-    from ..examples.cracked_rotor import cracked_rotor, healthy_rotor
+    from mutext.examples.cracked_rotor import cracked_rotor, healthy_rotor
     if name == "healthy":
         return healthy_rotor()
     if name == "breathing":
@@ -90,7 +90,7 @@ def _make_model(name):
     if name == "fixed_crack":           # the same crack, not turning with the shaft: time-invariant
         return cracked_rotor(0.4, breathing=None)
     if name == "bearings":              # both ball bearings 40 % softer: time-invariant
-        from ..rotor import data_path, loads_model
+        from mutext.rotor import data_path, loads_model
         with open(data_path("rotor.toml"), encoding="utf-8") as fh:
             text = fh.read()
         return loads_model(text.replace("stiffness = 1.0e7", "stiffness = 6.0e6"),
@@ -114,7 +114,7 @@ def sweep(name, noise, seed):
     The same numbers as ``measure_rotor(model, "i12", "x13", noise=noise, rng=seed)``, which adds the
     noise to the exact sweep with :func:`mutext.rig.with_noise`; the exact sweep (the costly harmonic
     balance) is computed once per model and shared by its noisy copies."""
-    from ..rig import measure_rotor, with_noise
+    from mutext.rig import measure_rotor, with_noise
     m = model(name)
     exact = _cached(("exact", name), lambda: measure_rotor(m, "i12", "x13"))
 
@@ -291,7 +291,7 @@ def _check_c(outcomes, calls):
     return score, fb
 
 
-def questions():
+def questions(rng=None):
     """The three questions; the sweeps and reference answers are made here, not in the child."""
     a_calls = []
     for label, fn, speed, orders, lo, hi in _a_cases():

@@ -12,8 +12,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..lti import check_finite, freqresp, ss
-from ..response import frequency_grid
+from mutext.lti import check_finite, freqresp, ss
+from mutext.response import frequency_grid
 
 __all__ = ["build_ss", "fmt", "ChannelCheck", "compare_responses", "matches", "permutation_hint",
            "resonance_safe_grid"]

@@ -1,19 +1,24 @@
 """Exercises, questions, scoring and reports of the autograder."""
 from __future__ import annotations
 
+import hashlib
+import hmac
 import importlib
 import math
+import secrets as _secrets
 import threading
 import time
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Callable
 
-from ..errors import MutextError
-from .sandbox import Job, SandboxError, run_submission
+import numpy as np
+
+from mutext.errors import MutextError
+from mutext.grading.sandbox import Job, SandboxError, run_submission
 
 __all__ = ["GradingError", "Call", "Question", "Exercise", "QuestionReport", "Report", "EXERCISES",
-           "get_exercise", "grade"]
+           "get_exercise", "grade", "read_secret", "input_seed"]
 
 
 class GradingError(MutextError):
@@ -53,9 +58,10 @@ class Question:
 class Exercise:
     name: str
     title: str
-    questions: Callable          # () -> list[Question]; built lazily (references cost time)
+    questions: Callable          # (rng) -> list[Question]: inputs drawn from ``rng`` (a numpy Generator)
     stub: str = ""               # path of the file students fill in, relative to the repository
-    prepare: Callable | None = None   # expensive reference computations, run while the child works
+    prepare: Callable | None = None   # (rng) -> None: expensive reference computations, run while the child
+    #                                   works, given a generator seeded as the one ``questions`` got
     blocked_modules: tuple = ()  # library modules that compute this exercise's answers (not importable)
 
 
@@ -83,6 +89,7 @@ class Report:
     notes: list = field(default_factory=list)
     isolation: str = "none"      # "uid", "landlock" or "none": how the submission's process was confined
     isolation_details: list = field(default_factory=list)
+    inputs: str = ""             # where the inputs came from (the course secret, or the seed of this run)
 
     @property
     def isolated(self) -> bool:
@@ -116,7 +123,7 @@ class Report:
             "output": "\n".join([f"{self.exercise}: {self.score:g} / {self.max_score:g}"] + self.notes
                                 + [self.isolation_text]),
             "isolation": self.isolation,
-            "extra_data": {"isolation_details": list(self.isolation_details)},
+            "extra_data": {"isolation_details": list(self.isolation_details), "inputs": self.inputs},
             "tests": [{"name": q.name, "score": float(q.score), "max_score": float(q.max_score),
                        "output": q.output} for q in self.questions],
         }
@@ -124,7 +131,8 @@ class Report:
     def text(self) -> str:
         """Human-readable report: points and feedback per question, then the total."""
         lines = [f"Exercise {self.exercise}: {self.title}", f"Submission: {self.submission}",
-                 self.isolation_text[0].upper() + self.isolation_text[1:], ""]
+                 self.isolation_text[0].upper() + self.isolation_text[1:]]
+        lines += ([f"Inputs: {self.inputs}"] if self.inputs else []) + [""]
         lines += [f"note: {n}" for n in self.notes]
         if self.notes:
             lines.append("")
@@ -138,20 +146,20 @@ class Report:
 
 #: name -> (module with ``EXERCISE``, one-line description)
 EXERCISES = {
-    "ex01_two_mass_hinf": ("mutext.grading.ex01_two_mass_hinf",
+    "ex01_two_mass_hinf": ("mutext_grader.ex01_two_mass_hinf",
                            "two-mass system: mechanical model, generalized plant, H-infinity norm, controller"),
-    "ex02_mu": ("mutext.grading.ex02_mu",
+    "ex02_mu": ("mutext_grader.ex02_mu",
                 "structured singular value: full-block mu, D-scaling upper bound, destabilising Delta, "
                 "uncertain spring as an LFT, peak over frequency"),
-    "ex03_free_decay": ("mutext.grading.ex03_free_decay",
+    "ex03_free_decay": ("mutext_grader.ex03_free_decay",
                         "free-decay identification of a cart: frequency, damping ratio, mass, stiffness, "
                         "damping coefficient"),
-    "ex04_beam_element": ("mutext.grading.ex04_beam_element",
+    "ex04_beam_element": ("mutext_grader.ex04_beam_element",
                           "Euler-Bernoulli beam elements: element matrices, assembly, natural frequencies, "
                           "convergence"),
-    "ex05_diagnose": ("mutext.grading.ex05_diagnose",
+    "ex05_diagnose": ("mutext_grader.ex05_diagnose",
                       "diagnosis: log misfit, a grounded spring added, its size fitted, a hidden effect found"),
-    "ex06_sidebands": ("mutext.grading.ex06_sidebands",
+    "ex06_sidebands": ("mutext_grader.ex06_sidebands",
                        "cracked rotor at speed: where sidebands appear, a local sideband detector, breathing "
                        "crack, open crack or none"),
 }
@@ -200,7 +208,34 @@ def _clip(x, hi):
     return round(min(max(float(x), 0.0), float(hi)), 2)
 
 
-def grade(exercise: str, submission, time_limit: float = 60.0, *, require_isolation: bool = False) -> Report:
+#: bytes of a course secret at least (an instructor's file of random bytes, ``secrets.token_bytes(32)``)
+SECRET_MIN_BYTES = 16
+
+
+def read_secret(path) -> bytes:
+    """The course secret in the file ``path`` (at least :data:`SECRET_MIN_BYTES` bytes; surrounding
+    whitespace is ignored, so a hex or base64 line works as well as raw bytes)."""
+    try:
+        data = Path(path).read_bytes().strip()
+    except OSError as exc:
+        raise GradingError(f"cannot read the course secret {path}: {exc.strerror or exc}") from None
+    if len(data) < SECRET_MIN_BYTES:
+        raise GradingError(f"the course secret {path} holds {len(data)} bytes; at least {SECRET_MIN_BYTES} are "
+                           "needed (e.g. python -c 'import secrets; print(secrets.token_hex(32))' > FILE)")
+    return data
+
+
+def input_seed(exercise: str, submission_bytes: bytes, secret: bytes) -> int:
+    """The seed of a submission's inputs in course mode: an HMAC of the exercise and the file's content
+    under the course secret.  Without the secret nobody can compute it; the same file is always graded on
+    the same inputs (a regrade gives the same score), and any edit of the file draws new ones, so answers
+    learned from one run cannot be pasted into the next."""
+    msg = exercise.encode() + b"\0" + hashlib.sha256(submission_bytes).digest()
+    return int.from_bytes(hmac.new(secret, msg, hashlib.sha256).digest()[:8], "little")
+
+
+def grade(exercise: str, submission, time_limit: float = 60.0, *, require_isolation: bool = False,
+          secret: bytes | None = None, seed: int | None = None) -> Report:
     """Grade ``submission`` (a ``.py`` file) for ``exercise``.
 
     The submission runs in a confined child process (:mod:`mutext.grading.sandbox`)
@@ -225,6 +260,13 @@ def grade(exercise: str, submission, time_limit: float = 60.0, *, require_isolat
     time_limit : float
         Seconds allowed for importing the submission and for each question
         (a positive, finite number).
+    secret : bytes, optional
+        The course secret (:func:`read_secret`): the inputs are drawn from a
+        seed computed from it and the submission's content
+        (:func:`input_seed`), which students cannot compute.
+    seed : int, optional
+        Draw the inputs from this seed instead (to repeat a run). Without
+        ``secret`` or ``seed`` the inputs are drawn afresh on every run.
 
     Returns
     -------
@@ -253,13 +295,25 @@ def grade(exercise: str, submission, time_limit: float = 60.0, *, require_isolat
     if path.suffix != ".py":
         raise GradingError(f"a submission is a Python file (.py), got {path.name}")
     t0 = time.perf_counter()
-    questions = ex.questions()
+    if seed is not None:
+        if isinstance(seed, bool) or not isinstance(seed, (int, np.integer)) or seed < 0:
+            raise GradingError(f"the seed must be a non-negative integer, got {seed!r}")
+        inputs = f"drawn from seed {int(seed)}"
+    elif secret is not None:
+        seed = input_seed(ex.name, path.read_bytes(), secret)
+        inputs = "drawn for this file from the course secret"
+    else:
+        seed = _secrets.randbits(63)
+        inputs = f"drawn afresh for this run (seed {seed}; --seed {seed} repeats it)"
+    seed = int(seed)
+    questions = ex.questions(np.random.default_rng(seed))
     jobs = [Job(q.id, q.function, q.kind, [{"args": c.args, "kwargs": c.kwargs} for c in q.calls])
             for q in questions]
     warm = None
     if ex.prepare is not None:
         # the reference computations overlap with the child's run; checks wait for them
-        warm = threading.Thread(target=_quietly, args=(ex.prepare,), daemon=True)
+        warm = threading.Thread(target=_quietly, args=(lambda: ex.prepare(np.random.default_rng(seed)),),
+                                daemon=True)
         warm.start()
     try:
         res = run_submission(path, jobs, time_limit=time_limit, blocked_modules=ex.blocked_modules)
@@ -312,4 +366,4 @@ def grade(exercise: str, submission, time_limit: float = 60.0, *, require_isolat
         notes.insert(0, why)
         reports = [QuestionReport(r.id, r.name, 0.0, r.max_score, [why], "not isolated") for r in reports]
     return Report(ex.name, ex.title, str(submission), reports, time.perf_counter() - t0, notes,
-                  res.isolation, list(res.isolation_details))
+                  res.isolation, list(res.isolation_details), inputs)

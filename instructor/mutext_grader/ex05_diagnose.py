@@ -28,7 +28,7 @@ import math
 
 import numpy as np
 
-from ..response import frequency_grid
+from mutext.response import frequency_grid
 from .compare import as_array, fmt, returned
 from .core import Call, Exercise, Question
 
@@ -55,7 +55,7 @@ C_CASES = [("three-mass rig, spring at m2", "three_mass", 1, 150.0, 41, 0, 0),
 def chain(example):
     """(M, C, K, forces, sensors) of a shipped chain, as nested lists (plain numpy assembly)."""
     import tomllib
-    from ..hide import example_path, plain_chain
+    from mutext.hide import example_path, plain_chain
     with open(example_path(example), "rb") as fh:
         M, C, K, forces, sensors, _ = plain_chain(tomllib.load(fh))
     return M, C, K, forces, sensors
@@ -226,7 +226,7 @@ def _check_d(outcomes, calls):
     return score, fb
 
 
-def questions():
+def questions(rng=None):
     """The four questions; data and reference answers are made here, not in the child."""
     a_calls = []
     for label, h, d in _a_cases():

@@ -76,7 +76,7 @@ def exact_values(m, k, c):
 @functools.lru_cache(maxsize=16)
 def record(m, k, c, noise=0.0, seed=None):
     """A 3 s record sampled at 1 kHz from rest at 25 mm, as plain lists ``(t, y)``."""
-    from ..sysid import simulate_free_decay
+    from mutext.sysid import simulate_free_decay
     t, y = simulate_free_decay(m, k, c, x0=0.025, duration=3.0, fs=1000.0, noise=noise, rng=seed)
     return [round(float(v), 6) for v in t], [float(v) for v in y]
 
@@ -299,7 +299,7 @@ def _check_d(outcomes, calls):
     return score, fb
 
 
-def questions():
+def questions(rng=None):
     """The six questions with their test inputs (the records are simulated here, not in the child)."""
     a_calls = []
     for label, m, k, c, N in A_RECORDS:
