@@ -4,14 +4,51 @@ Questions (10 points):
 
 (a) ``mechanical_model(m1, m2, k1, k2)``, 2 points: compared channel by
     channel through frequency responses at two parameter sets.
-(b) ``generalized_plant(**params)``, 3 points: the same for the 9 channels of
-    the generalized plant, with defaults and with other keyword arguments.
+(b) ``generalized_plant(**params)``, 3 points: the 9 channels of the
+    generalized plant, called with no arguments (the defaults), with the
+    mechanical parameters only and with all eight.  A channel counts when it
+    is right in every call; the 6 channels that carry a signal share the
+    points, and each of the 3 channels that must be zero but is not takes one
+    share away.
 (c) ``hinf_norm(sys)``, 2 points: five stable systems, relative tolerance 1e-4.
 (d) ``controller()``, 3 points: the closed loop is rebuilt here with the
     reference plant; 1 point for stability, 2 more if the closed-loop norm is
     within 2 % of the optimal level (1 more if within 10 %).
 
-Partial credit is proportional to the channels or systems that are right.
+Inputs are drawn per run from the generator the grader passes
+(:func:`_draw`): the masses and stiffnesses 30 % around the thesis's and a
+second set's, the weights 10-40 % away from the defaults (so a weight or a
+scaling hard-coded to the default is seen), and the five systems of (c) of
+the same kinds as before (a low-pass with its peak at DC, a resonance with
+damping ratio about 0.001, a peak at infinite frequency, a random 2x2 MIMO
+system with 4 states, a damped two-mass model).  (d) has no inputs: the
+question names the thesis plant.  Labels name a case by its number and
+kind only; feedback names the student's own values and the mistake, never a
+reference value or a drawn parameter.
+
+What earns nothing (the answers that do not solve the question):
+
+* (a), (b): a zero model, a model that ignores its arguments (a table of
+  the thesis plant: its channels are wrong in the calls with other
+  arguments, and a channel counts only when right in every call), the
+  structurally zero channels of (b) alone;
+* (c): a function seen returning a known shortcut (the gain at DC, at
+  infinite frequency, the square of the norm) where it is wrong earns
+  nothing on the systems whose norm a shortcut happens to give (the peak at
+  DC, the peak at infinite frequency);
+* (d): a controller that does not stabilise the reference plant (a zero or
+  static controller leaves its undamped modes on the imaginary axis), one
+  whose closed loop has an infinite norm, or whose computed norm is beaten
+  by its own frequency response sampled at the plant's natural frequencies
+  and at its poles (a realisation so ill-conditioned that rounding would
+  pass an undamped mode as stable).
+
+Every returned model is checked for size in the check function before
+anything is built or computed: at most :data:`MAX_STATES_FACTOR` times the
+reference model's states (a model or controller padded to hundreds of
+states scores 0 with a message and is never computed).
+
+Partial credit is otherwise proportional to the channels or systems that are right.
 """
 from __future__ import annotations
 
@@ -22,8 +59,7 @@ import numpy as np
 
 from mutext.lti import hinf_norm as ref_hinf_norm
 from mutext.lti import lft_lower, mck_to_ss, ss
-from .compare import (build_ss, compare_responses, fmt, matches, permutation_hint, resonance_safe_grid, response,
-                      returned)
+from .compare import build_ss, compare_responses, fmt, matches, permutation_hint, resonance_safe_grid, response
 from .core import Call, Exercise, Question
 from .solutions import ex01_two_mass_hinf as sol
 
@@ -32,14 +68,153 @@ RTOL_MODEL = 1e-4      # frequency responses: different state coordinates only c
 RTOL_NORM = 1e-4
 CONTROLLER_FULL = 1.02     # closed-loop norm / optimal level for full marks
 CONTROLLER_PARTIAL = 1.10
+MAX_STATES_FACTOR = 3      # a returned model may have at most this many times the reference's states
+MODEL_STATES = 4           # states of the two-mass model, of the generalized plant and of the thesis controller
 
 DEFAULTS = dict(m1=1.0, m2=2.0, k1=450.0, k2=175.0, f_max=10.0, eta_max=1e-4, x_max=0.035, u_max=50.0)
 OTHER = dict(m1=1.5, m2=0.5, k1=300.0, k2=80.0, f_max=4.0, eta_max=2e-4, x_max=0.02, u_max=80.0)
 MECH = ["m1", "m2", "k1", "k2"]
+WEIGHTS = ["f_max", "eta_max", "x_max", "u_max"]
 
 
-def _describe_params(p):
-    return ", ".join(f"{k}={p[k]:g}" for k in p)
+# ----------------------------------------------------------------------------
+# inputs drawn per run
+# ----------------------------------------------------------------------------
+
+def _around(rng, x, rel=0.3):
+    """``x`` times a factor drawn in ``[1 - rel, 1 + rel]``."""
+    return float(x * rng.uniform(1.0 - rel, 1.0 + rel))
+
+
+def _away(rng, x):
+    """``x`` times a factor in ``[0.6, 0.9]`` or ``[1.1, 1.4]``: never the default itself."""
+    f = rng.uniform(0.6, 0.9) if rng.random() < 0.5 else rng.uniform(1.1, 1.4)
+    return float(x * f)
+
+
+def _stable_random(rng, n):
+    A = rng.standard_normal((n, n))
+    return A - (np.linalg.eigvals(A).real.max() + rng.uniform(0.2, 0.5)) * np.eye(n)
+
+
+def _draw(rng):
+    """Every graded input of one run, drawn from ``rng`` (``questions`` and ``prepare`` both call this)."""
+    d = {}
+    d["mech"] = [{k: _around(rng, base[k]) for k in MECH} for base in (DEFAULTS, OTHER)]
+    d["plant"] = [{},
+                  {k: _away(rng, DEFAULTS[k]) for k in MECH},
+                  {**{k: _around(rng, OTHER[k]) for k in MECH}, **{k: _away(rng, DEFAULTS[k]) for k in WEIGHTS}}]
+    systems = []
+    a, g = rng.uniform(0.5, 3.0), rng.uniform(1.0, 4.0)
+    systems.append(("first-order low-pass, peak at DC", ss([[-a]], [[1.0]], [[g]], [[0.0]])))
+    wn, z = rng.uniform(6.0, 16.0), 1e-3 * rng.uniform(0.7, 1.4)
+    systems.append(("lightly damped resonance (damping ratio about 0.001)",
+                    ss([[0.0, 1.0], [-wn * wn, -2 * z * wn]], [[0.0], [wn * wn]], [[1.0, 0.0]], [[0.0]])))
+    a = rng.uniform(0.5, 3.0)
+    b, dd = a * rng.uniform(0.05, 0.3), rng.uniform(0.5, 2.0)
+    systems.append(("a lead-lag whose peak is at infinite frequency (the D matrix)",
+                    ss([[-a]], [[1.0]], [[dd * (b - a)]], [[dd]])))
+    systems.append(("random 2x2 MIMO system with 4 states and D != 0",
+                    ss(_stable_random(rng, 4), rng.standard_normal((4, 2)), rng.standard_normal((2, 4)),
+                       0.3 * rng.standard_normal((2, 2)))))
+    p = {k: _around(rng, DEFAULTS[k]) for k in MECH}
+    M = np.diag([p["m1"], p["m2"]])
+    K = np.array([[p["k1"], -p["k1"]], [-p["k1"], p["k1"] + p["k2"]]])
+    systems.append(("damped two-mass model [f_e, u] -> [x1, x2] (damping 0.02 K)",
+                    mck_to_ss(M, 0.02 * K, K, {"f_e": 0, "u": 1}, {"x1": 0, "x2": 1})))
+    d["systems"] = systems
+    return d
+
+
+def _raw_dims(value):
+    """Upper bounds of (states, inputs, outputs) read off the returned lists, before any matrix is built."""
+    A, B, C, D = (value.get(k) or [] for k in "ABCD")
+    n = max(len(A), max((len(r) for r in A), default=0), len(B), max((len(r) for r in C), default=0))
+    m = max(max((len(r) for r in B), default=0), max((len(r) for r in D), default=0))
+    p = max(len(C), len(D))
+    return n, m, p
+
+
+def _too_large(value, what, ref_states=MODEL_STATES, max_io=3):
+    """A message if the returned model is larger than the grader computes with (else None)."""
+    if not isinstance(value, dict):
+        return None
+    n, m, p = _raw_dims(value)
+    cap = MAX_STATES_FACTOR * ref_states
+    if n > cap:
+        return (f"{what}: the model has {n} states; at most {cap} are accepted ({MAX_STATES_FACTOR} times the "
+                f"{ref_states} of a minimal model): not evaluated, 0 points")
+    if m > 10 * max_io or p > 10 * max_io:
+        return f"{what}: the model has {m} inputs and {p} outputs: not evaluated, 0 points"
+    return None
+
+
+def _sized(outcomes, calls, what, ref_states=MODEL_STATES):
+    """The outcomes with oversized models replaced by an error before anything is computed."""
+    out = []
+    for oc in outcomes:
+        err = _too_large(oc.get("value"), what, ref_states) if oc.get("ok") else None
+        out.append({"ok": False, "error": err} if err else oc)
+    return out
+
+
+def _band(got, exp):
+    """How far ``got`` is from ``exp``, in words that do not give ``exp`` away."""
+    r = abs(got / exp - 1.0) if exp else np.inf
+    if r < 1e-2:
+        return "by less than 1 %"
+    if r < 0.1:
+        return "by 1-10 %"
+    return "by more than 10 %"
+
+
+def _describe(gs, gr, w, label, atol, hints):
+    """A mismatching channel in words that name the student's values and the mistake, not the reference's."""
+    if not np.all(np.isfinite(gs)):
+        return f"channel {label}: the response is not finite at some test frequencies"
+    if np.all(np.abs(gr) <= atol):
+        return f"channel {label} should be zero, got a response of magnitude {np.abs(gs).max():.3g}"
+    if np.all(np.abs(gs) <= atol):
+        return f"channel {label} is missing: your model gives 0"
+    nz = np.abs(gr) > atol
+    r = gs[nz] / gr[nz]
+    if r.size and np.all(np.abs(r - r[0]) <= 1e-4 * abs(r[0])):
+        factor = r[0].real if abs(r[0].imag) <= 1e-6 * abs(r[0]) else r[0]
+        for f, text in hints:
+            if np.isreal(factor) and abs(factor - f) <= 1e-4 * abs(f):
+                return f"channel {label} is off by a constant factor: {text}"
+        if np.isreal(factor) and factor < 0:
+            return f"channel {label} has the opposite sign and a different size"
+        return f"channel {label} is off by a constant factor (a weight, a scaling or a sign)"
+    bad = int(np.sum(np.abs(gs - gr) > RTOL_MODEL * np.abs(gr) + atol))
+    return f"channel {label} has different dynamics (it differs at {bad} of the {len(w)} test frequencies)"
+
+
+def _channels(Gs, Gr, w, ins, outs, hints=None):
+    """``(ok, message)`` per channel, in the order output-major (as :func:`compare_responses`)."""
+    atol = 1e-9 * max(np.abs(Gr).max(), 1e-300)
+    checks = compare_responses(Gs, Gr, w, ins, outs, rtol=RTOL_MODEL, atol=atol)
+    out = []
+    for k, c in enumerate(checks):
+        i, j = divmod(k, Gr.shape[1])
+        msg = "" if c.ok else _describe(Gs[i, j], Gr[i, j], w, f"{c.inp} -> {c.out}", atol,
+                                        hints(i, j) if hints else [])
+        out.append((c.ok, msg))
+    return out
+
+
+def _parsed(outcomes, calls, feedback, what):
+    """``(index, call, tag, StateSpace)`` of the calls that returned a model."""
+    for i, (call, oc) in enumerate(zip(calls, outcomes)):
+        tag = f"[{call.label}]"
+        if not oc["ok"]:
+            feedback.append(f"{tag} {oc['error']}")
+            continue
+        S, err = build_ss(oc["value"], what)
+        if err:
+            feedback.append(f"{tag} {err}")
+            continue
+        yield i, call, tag, S
 
 
 # ----------------------------------------------------------------------------
@@ -66,7 +241,8 @@ def _check_mechanical(outcomes, calls):
     ins, outs = ["f_e", "u"], ["x1", "x2"]
     n_ok, n_all = 0, 4 * len(calls)
     fb = []
-    for call, tag, S in returned(outcomes, calls, fb, build_ss, "mechanical_model()"):
+    outcomes = _sized(outcomes, calls, "mechanical_model()")
+    for _, call, tag, S in _parsed(outcomes, calls, fb, "mechanical_model()"):
         p = dict(zip(MECH, call.args))
         ref = sol.mechanical_model(**p)
         if (S.ninputs, S.noutputs) != (2, 2):
@@ -79,16 +255,16 @@ def _check_mechanical(outcomes, calls):
         if err:
             fb.append(f"{tag} {err}")
             continue
-        checks = compare_responses(Gs, Gr, w, ins, outs, rtol=RTOL_MODEL)
-        n_ok += sum(c.ok for c in checks)
-        if all(c.ok for c in checks):
+        checks = _channels(Gs, Gr, w, ins, outs)
+        n_ok += sum(ok for ok, _ in checks)
+        if all(ok for ok, _ in checks):
             continue
         atol = 1e-9 * np.abs(Gr).max()
         hint = permutation_hint(Gs, Gr, ins, outs, RTOL_MODEL)
         for alt, text in _mech_alternatives(**p):
             if hint is None and matches(Gs, response(alt, w)[0], RTOL_MODEL, atol):
                 hint = text
-        fb += [f"{tag} {c.message}" for c in checks if not c.ok]
+        fb += [f"{tag} {msg}" for ok, msg in checks if not ok]
         if hint:
             fb.append(f"{tag} hint: {hint}")
     if n_ok == n_all:
@@ -108,30 +284,33 @@ CHANNEL_ROLE = {
     ("f2", "z2"): "must be zero", ("u", "z2"): "control weight",
     ("f1", "y"): "disturbance to measurement", ("f2", "y"): "sensor noise", ("u", "y"): "control force to measurement",
 }
+ZERO_CHANNELS = {("f2", "z1"), ("f1", "z2"), ("f2", "z2")}
 
 
 def _plant_hints(p):
-    """(out, in) -> list of (factor, explanation) for constant-factor errors."""
+    """(out, in) -> list of (factor, explanation) for constant-factor errors (no numbers in the texts)."""
     d = DEFAULTS
     rows = {
-        0: [(p["x_max"] ** 2, f"the z1 weight looks like {p['x_max']:g} instead of 1/{p['x_max']:g}"),
-            (p["x_max"], f"z1 looks unweighted: x1 must be divided by x_max = {p['x_max']:g} m"),
+        0: [(p["x_max"] ** 2, "the z1 weight looks like x_max instead of 1/x_max"),
+            (p["x_max"], "z1 looks unweighted: x1 must be divided by x_max"),
             (28.6 * p["x_max"], "the z1 weight looks like the thesis's rounded 28.6 instead of 1/x_max"),
-            (p["x_max"] / d["x_max"], f"the z1 weight looks hard-coded to 1/{d['x_max']:g} instead of 1/x_max"),
+            (p["x_max"] / d["x_max"], "the z1 weight looks hard-coded to the default 1/x_max instead of using "
+                                      "the argument x_max"),
             (-1.0, "the sign of z1 is flipped")],
-        1: [(p["u_max"] ** 2, f"the z2 weight looks like {p['u_max']:g} instead of 1/{p['u_max']:g}"),
-            (p["u_max"], f"z2 looks unweighted: u must be divided by u_max = {p['u_max']:g} N"),
-            (p["u_max"] / d["u_max"], f"the z2 weight looks hard-coded to 1/{d['u_max']:g} instead of 1/u_max"),
+        1: [(p["u_max"] ** 2, "the z2 weight looks like u_max instead of 1/u_max"),
+            (p["u_max"], "z2 looks unweighted: u must be divided by u_max"),
+            (p["u_max"] / d["u_max"], "the z2 weight looks hard-coded to the default 1/u_max instead of using "
+                                      "the argument u_max"),
             (-1.0, "the sign of z2 is flipped")],
         2: [(-1.0, "the sign of y is flipped")],
     }
     cols = {
-        0: [(1 / p["f_max"], f"f1 is not scaled: the force on m1 is f_max*f1 with f_max = {p['f_max']:g} N"),
-            (p["f_max"] ** -2, f"f1 looks scaled by 1/{p['f_max']:g} instead of {p['f_max']:g}"),
-            (d["f_max"] / p["f_max"], f"f_max looks hard-coded to {d['f_max']:g} instead of the argument")],
-        1: [(1 / p["eta_max"], f"f2 is not scaled: the noise is eta_max*f2 with eta_max = {p['eta_max']:g} m"),
-            (p["eta_max"] ** -2, f"f2 looks scaled by 1/{p['eta_max']:g} instead of {p['eta_max']:g}"),
-            (d["eta_max"] / p["eta_max"], f"eta_max looks hard-coded to {d['eta_max']:g} instead of the argument")],
+        0: [(1 / p["f_max"], "f1 is not scaled: the force on m1 is f_max*f1"),
+            (p["f_max"] ** -2, "f1 looks scaled by 1/f_max instead of f_max"),
+            (d["f_max"] / p["f_max"], "f_max looks hard-coded to the default instead of the argument")],
+        1: [(1 / p["eta_max"], "f2 is not scaled: the noise is eta_max*f2"),
+            (p["eta_max"] ** -2, "f2 looks scaled by 1/eta_max instead of eta_max"),
+            (d["eta_max"] / p["eta_max"], "eta_max looks hard-coded to the default instead of the argument")],
         2: [(-1.0, "the sign of u is flipped")],
     }
 
@@ -142,9 +321,12 @@ def _plant_hints(p):
 
 
 def _check_plant(outcomes, calls):
-    n_ok, n_all = 0, 9 * len(calls)
+    names = [(i, o) for o in PLANT_OUTPUTS for i in PLANT_INPUTS]    # output-major, as _channels
+    right = {c: True for c in names}
     fb = []
-    for call, tag, S in returned(outcomes, calls, fb, build_ss, "generalized_plant()"):
+    outcomes = _sized(outcomes, calls, "generalized_plant()")
+    usable = set()
+    for idx, call, tag, S in _parsed(outcomes, calls, fb, "generalized_plant()"):
         p = {**DEFAULTS, **call.kwargs}
         ref = sol.generalized_plant(**p)
         if (S.ninputs, S.noutputs) != (3, 3):
@@ -157,78 +339,97 @@ def _check_plant(outcomes, calls):
         if err:
             fb.append(f"{tag} {err}")
             continue
-        outs = [f"{o}" for o in PLANT_OUTPUTS]
-        checks = compare_responses(Gs, Gr, w, PLANT_INPUTS, outs, rtol=RTOL_MODEL, hints=_plant_hints(p))
-        n_ok += sum(c.ok for c in checks)
-        for c in checks:
-            if not c.ok:
-                # "channel f2 -> y differs ..." becomes "channel f2 -> y (sensor noise) differs ..."
-                label = f"{c.inp} -> {c.out}"
-                fb.append(f"{tag} " + c.message.replace(label, f"{label} ({CHANNEL_ROLE[(c.inp, c.out)]})", 1))
+        usable.add(idx)
+        for (inp, out), (ok, msg) in zip(names, _channels(Gs, Gr, w, PLANT_INPUTS, PLANT_OUTPUTS,
+                                                          _plant_hints(p))):
+            if not ok:
+                right[(inp, out)] = False
+                # "channel f2 -> y ..." becomes "channel f2 -> y (sensor noise) ..."
+                label = f"{inp} -> {out}"
+                fb.append(f"{tag} " + msg.replace(label, f"{label} ({CHANNEL_ROLE[(inp, out)]})", 1))
         hint = permutation_hint(Gs, Gr, PLANT_INPUTS, PLANT_OUTPUTS, RTOL_MODEL)
         if hint:
             fb.append(f"{tag} hint: {hint}")
-    if n_ok == n_all:
-        fb.insert(0, "correct: all 9 channels match with the default and with other arguments")
-    return POINTS["b"] * n_ok / n_all, fb
+    if len(usable) < len(calls):
+        right = {c: False for c in names}
+    signal = [c for c in names if c not in ZERO_CHANNELS]
+    n_ok = sum(right[c] for c in signal) - sum(not right[c] for c in ZERO_CHANNELS)
+    if n_ok == len(signal) and all(right.values()):
+        fb.insert(0, "correct: all 9 channels match with the defaults and with other arguments")
+    elif usable and any(right[c] for c in ZERO_CHANNELS) and not any(right[c] for c in signal):
+        fb.append("the channels that must be zero earn nothing by themselves")
+    return POINTS["b"] * max(n_ok, 0) / len(signal), fb
 
 
 # ----------------------------------------------------------------------------
 # (c) H-infinity norm
 # ----------------------------------------------------------------------------
 
-def _norm_systems():
-    """(label, StateSpace) of stable test systems, chosen to catch the usual shortcuts."""
-    out = []
-    out.append(("first-order low-pass 2/(s+1), peak at DC", ss([[-1.0]], [[1.0]], [[2.0]], [[0.0]])))
-    wn, z = 10.0, 1e-3
-    out.append((f"lightly damped resonance (zeta={z:g}, wn={wn:g} rad/s)",
-                ss([[0.0, 1.0], [-wn * wn, -2 * z * wn]], [[0.0], [wn * wn]], [[1.0, 0.0]], [[0.0]])))
-    out.append(("(s+0.1)/(s+1), peak at infinite frequency (the D matrix)",
-                ss([[-1.0]], [[1.0]], [[-0.9]], [[1.0]])))
-    rng = np.random.default_rng(3)
-    A = rng.standard_normal((4, 4))
-    A -= (np.linalg.eigvals(A).real.max() + 0.3) * np.eye(4)
-    out.append(("random 2x2 MIMO system with 4 states and D != 0",
-                ss(A, rng.standard_normal((4, 2)), rng.standard_normal((2, 4)), 0.3 * rng.standard_normal((2, 2)))))
-    M = np.diag([1.0, 2.0])
-    K = np.array([[450.0, -450.0], [-450.0, 625.0]])
-    out.append(("damped two-mass model [f_e, u] -> [x1, x2] (damping 0.02 K)",
-                mck_to_ss(M, 0.02 * K, K, {"f_e": 0, "u": 1}, {"x1": 0, "x2": 1})))
-    return out
+def _norm_systems(draw=None):
+    """(label, StateSpace) of the stable test systems of one run (a fresh draw without ``draw``)."""
+    return (draw if draw is not None else _draw(np.random.default_rng()))["systems"]
+
+
+@functools.lru_cache(maxsize=64)
+def _norm_cached(key):
+    A, B, C, D = (np.array(x, dtype=float).reshape(s) for x, s in key)
+    return ref_hinf_norm(ss(A, B, C, D)).value
+
+
+def _ref_norm(sys_):
+    key = tuple((tuple(np.asarray(X, float).ravel().tolist()), np.asarray(X).shape)
+                for X in (sys_.A, sys_.B, sys_.C, sys_.D))
+    with _LOCK:
+        return _norm_cached(key)
+
+
+def _shortcuts(sys_, exp):
+    """``(value, name, text)`` of the usual shortcuts for the norm of ``sys_``."""
+    dc = float(np.linalg.norm(response(sys_, [0.0])[0][:, :, 0], 2))
+    D = float(np.linalg.norm(np.asarray(sys_.D, float), 2))
+    return [(dc, "the gain at DC", "that is the gain at DC, but the peak is elsewhere"),
+            (D, "the gain at infinite frequency",
+             "that is the gain at infinite frequency (the D matrix), but the peak is elsewhere"),
+            (exp * exp, "the square of the norm", "that is the square of the norm")]
 
 
 def _check_norm(outcomes, calls, systems):
-    n_ok = 0
     fb = []
+    right, caught, easy = [], set(), []
     for call, oc, (label, sys_) in zip(calls, outcomes, systems):
-        ref = ref_hinf_norm(sys_)
-        exp = ref.value
+        exp = _ref_norm(sys_)
+        cuts = _shortcuts(sys_, exp)
+        easy.append({name for v, name, _ in cuts if abs(v - exp) <= RTOL_NORM * exp})
         if not oc["ok"]:
+            right.append(False)
             fb.append(f"[{label}] {oc['error']}")
             continue
-        got = oc["value"]
+        got = float(oc["value"])
         if np.isfinite(got) and abs(got - exp) <= RTOL_NORM * exp:
-            n_ok += 1
+            right.append(True)
             continue
-        where = "infinite frequency" if not np.isfinite(ref.frequency) else f"{ref.frequency:.4g} rad/s"
-        msg = f"[{label}] expected {exp:.6g} (peak at {where}), got {fmt(got) if np.isfinite(got) else got}"
-        dc = np.linalg.norm(response(sys_, [0.0])[0][:, :, 0], 2)
-        D = np.linalg.norm(np.asarray(sys_.D, float), 2)
+        right.append(False)
+        msg = f"[{label}] your value {fmt(got)} is wrong"
+        hit = [(name, t) for v, name, t in cuts
+               if abs(got - v) <= 1e-6 * max(abs(v), 1e-300) and abs(v - exp) > RTOL_NORM * exp]
+        caught.update(name for name, _ in hit)
         if not np.isfinite(got):
             msg += ": the system is stable, so its norm is finite"
-        elif abs(got - dc) <= 1e-6 * max(dc, 1e-300) and abs(dc - exp) > RTOL_NORM * exp:
-            msg += ": that is the gain at DC, but the peak is elsewhere"
-        elif abs(got - D) <= 1e-6 * max(D, 1e-300) and abs(D - exp) > RTOL_NORM * exp:
-            msg += ": that is the gain at infinite frequency (the D matrix), but the peak is elsewhere"
-        elif abs(got - exp * exp) <= RTOL_NORM * exp * exp:
-            msg += ": that is the square of the norm"
+        elif hit:
+            msg += ": " + hit[0][1]
         elif got < exp:
-            msg += (f" ({100 * (1 - got / exp):.3g} % too low): a frequency grid misses narrow peaks; "
+            msg += (f", too low {_band(got, exp)}: a frequency grid misses narrow peaks; "
                     "refine near the peak or use the Hamiltonian bisection")
         else:
-            msg += f" ({100 * (got / exp - 1):.3g} % too high)"
+            msg += f", too high {_band(got, exp)}"
         fb.append(msg)
+    n_ok = 0
+    for (label, _), ok, e in zip(systems, right, easy):
+        if ok and e and caught:
+            fb.append(f"[{label}] 0 points: a shortcut ({sorted(caught)[0]}) was returned for another system, "
+                      f"and this system's norm happens to be {sorted(e)[0]}")
+        elif ok:
+            n_ok += 1
     if n_ok == len(systems):
         fb.insert(0, f"correct: all {len(systems)} norms within a relative {RTOL_NORM:g}")
     return POINTS["c"] * n_ok / len(systems), fb
@@ -238,7 +439,7 @@ def _check_norm(outcomes, calls, systems):
 # (d) controller
 # ----------------------------------------------------------------------------
 
-_LOCK = threading.Lock()   # several submissions may be graded from threads; solve the LMIs once
+_LOCK = threading.RLock()   # several submissions may be graded from threads; solve the LMIs once
 
 
 def reference_problem():
@@ -255,10 +456,24 @@ def _reference_problem():
     return P, float(hinfsyn(P, 1, 1).gamma)
 
 
+def _sampled_peak(CL, poles, P):
+    """The largest gain of the closed loop sampled at the plant's natural frequencies, at its own poles'
+    frequencies and on a log grid (``inf`` where the response cannot be evaluated)."""
+    wp = np.abs(np.linalg.eigvals(np.asarray(P.A, float)).imag)
+    w = np.unique(np.concatenate([[0.0], wp, np.abs(poles.imag), np.abs(poles), np.logspace(-1, 5, 200)]))
+    G, err = response(CL, w)
+    if err or not np.all(np.isfinite(G)):
+        return np.inf
+    return float(max(np.linalg.norm(G[:, :, k], 2) for k in range(G.shape[2])))
+
+
 def _check_controller(outcomes, calls):
     oc = outcomes[0]
     if not oc["ok"]:
         return 0.0, [oc["error"]]
+    big = _too_large(oc["value"], "controller()", MODEL_STATES, max_io=1)
+    if big:
+        return 0.0, [big]
     K, err = build_ss(oc["value"], "controller()")
     if err:
         return 0.0, [err]
@@ -275,9 +490,16 @@ def _check_controller(outcomes, calls):
         return 0.0, [f"the closed loop (reference plant with your controller, u = K y) is unstable: pole at "
                      f"s = {fmt(worst)} 1/s; check the sign convention u = +K y"]
     norm = ref_hinf_norm(CL).value
+    if not np.isfinite(norm):
+        return 0.0, ["the closed loop (reference plant with your controller, u = K y) has an infinite H-infinity "
+                     "norm: it is not stable (an undamped mode of the plant is left as it is)"]
+    if _sampled_peak(CL, poles, P) > norm * (1.0 + 1e-3):
+        return 0.0, ["the closed loop's frequency response exceeds its computed H-infinity norm: the loop is "
+                     "numerically at the edge of stability (an undamped mode of the plant is not damped, or the "
+                     "controller's realisation is badly conditioned); 0 points"]
     ratio = norm / gamma
-    fb = [f"closed loop stable (1 point); closed-loop H-infinity norm {norm:.6g}, optimal level {gamma:.6g} "
-          f"({100 * (ratio - 1):+.3g} %)"]
+    fb = [f"closed loop stable (1 point); closed-loop H-infinity norm {norm:.6g}, "
+          f"{100 * (ratio - 1):+.3g} % from the optimal level"]
     if ratio <= CONTROLLER_FULL:
         return 3.0, fb + [f"correct: within {100 * (CONTROLLER_FULL - 1):g} % of the optimal level"]
     if ratio <= CONTROLLER_PARTIAL:
@@ -289,12 +511,22 @@ def _check_controller(outcomes, calls):
 
 # ----------------------------------------------------------------------------
 
+def prepare(rng=None):
+    """The reference computations of a run (the same draws as :func:`questions` with an equal generator)."""
+    reference_problem()
+    if rng is not None:
+        for _, s in _draw(rng)["systems"]:
+            _ref_norm(s)
+
+
 def questions(rng=None):
-    """The four questions with their test inputs."""
-    a_calls = [Call("m1=1, m2=2, k1=450, k2=175", args=[DEFAULTS[k] for k in MECH]),
-               Call("m1=1.5, m2=0.5, k1=300, k2=80", args=[OTHER[k] for k in MECH])]
-    b_calls = [Call("default arguments"), Call(_describe_params(OTHER), kwargs=dict(OTHER))]
-    systems = _norm_systems()
+    """The four questions with their inputs drawn from ``rng`` (a fresh generator without one)."""
+    draw = _draw(rng if rng is not None else np.random.default_rng())
+    mech = draw["mech"]
+    a_calls = [Call(f"parameter set {i + 1} of {len(mech)}", args=[p[k] for k in MECH]) for i, p in enumerate(mech)]
+    b_labels = ["default arguments", "the masses and stiffnesses given, default weights", "all eight arguments given"]
+    b_calls = [Call(lab, kwargs=dict(kw)) for lab, kw in zip(b_labels, draw["plant"])]
+    systems = draw["systems"]
     c_calls = [Call(label, args=[{"__ss__": [np.asarray(getattr(s, X), float).tolist() for X in "ABCD"]}])
                for label, s in systems]
     d_calls = [Call("controller()")]
@@ -311,4 +543,4 @@ def questions(rng=None):
 
 
 EXERCISE = Exercise("ex01_two_mass_hinf", "H-infinity control of the two-mass system", questions,
-                    stub="exercises/ex01_two_mass_hinf.py", prepare=lambda rng=None: reference_problem())
+                    stub="exercises/ex01_two_mass_hinf.py", prepare=prepare)
