@@ -1,4 +1,5 @@
-"""Command-line interface: ``mutext diagnose``, ``mutext rig``, ``mutext frf``, ``mutext demo`` and ``mutext grade``."""
+"""Command-line interface: ``mutext diagnose``, ``mutext rig``, ``mutext frf``, ``mutext demo``, ``mutext check``
+and ``mutext grade``."""
 from __future__ import annotations
 
 import argparse
@@ -85,6 +86,78 @@ def _cmd_module(name, argv) -> int:
     return int(mod.run(p.parse_args(argv)) or 0)
 
 
+def _check_parser():
+    p = argparse.ArgumentParser(
+        prog="mutext check",
+        description="Check an exercise file locally: run it, confined as the grader runs it, on sample inputs "
+                    "drawn afresh, and say per function whether it runs and returns the right kind and shape of "
+                    "value. It never says whether the values are right: grading happens on the instructor's side.",
+        epilog="Exit code 0 when every function runs and returns the right kind of value, 1 when some do not, "
+               "2 on wrong usage (unknown exercise, missing file, not a .py file).")
+    p.add_argument("exercise", nargs="?", help="exercise name (see --list); a unique prefix such as ex01 works")
+    p.add_argument("file", nargs="?", help="your .py file")
+    p.add_argument("--list", action="store_true", help="list the exercises and their functions, and exit")
+    p.add_argument("--json", action="store_true", help="print the result as JSON")
+    p.add_argument("--time-limit", type=float, default=60.0, metavar="SECONDS",
+                   help="wall-clock limit for importing the file and for each function (default 60)")
+    p.add_argument("--seed", type=int, default=None, metavar="N",
+                   help="draw the sample inputs from seed N (to repeat a check; the report prints its seed)")
+    return p
+
+
+def _cmd_check(argv) -> int:
+    import json
+    import math
+    from pathlib import Path
+    from .grading.check import CheckError, check, exercise_list
+    from .grading.spec import EXERCISES, find_exercise
+    p = _check_parser()
+    try:
+        args = p.parse_args(list(argv))
+    except SystemExit as exc:     # --help, or wrong usage (argparse printed why)
+        return 0 if not exc.code else 2
+    if args.list:
+        rows = exercise_list()
+        if args.json:
+            print(json.dumps([{"name": n, "title": t, "description": d, "functions": f} for n, t, d, f in rows],
+                             indent=2))
+            return 0
+        width = max(len(n) for n, *_ in rows)
+        for name, _, desc, funcs in rows:
+            print(f"{name:<{width}}  {desc}")
+            print(f"{'':<{width}}  functions: {', '.join(funcs)}")
+        return 0
+    if not args.exercise or not args.file:
+        p.print_usage(sys.stderr)
+        print("mutext check: error: EXERCISE and FILE are required (or --list)", file=sys.stderr)
+        return 2
+    if find_exercise(args.exercise) is None:
+        print(f"mutext check: error: unknown exercise '{args.exercise}'. Available: {', '.join(EXERCISES)}",
+              file=sys.stderr)
+        return 2
+    if not math.isfinite(args.time_limit) or args.time_limit <= 0:
+        print(f"mutext check: error: --time-limit must be a positive number of seconds, got {args.time_limit:g}",
+              file=sys.stderr)
+        return 2
+    path = Path(args.file)
+    if not path.exists():
+        print(f"mutext check: error: file not found: {args.file}", file=sys.stderr)
+        return 2
+    if not path.is_file() or path.suffix != ".py":
+        print(f"mutext check: error: expected a Python file (.py), got {args.file}", file=sys.stderr)
+        return 2
+    if args.seed is not None and args.seed < 0:
+        print("mutext check: error: --seed takes a non-negative integer", file=sys.stderr)
+        return 2
+    try:
+        report = check(args.exercise, path, time_limit=args.time_limit, seed=args.seed)
+    except CheckError as exc:
+        print(f"mutext check: error: {exc}", file=sys.stderr)
+        return 2 if exc.usage else 1
+    print(json.dumps(report.to_dict(), indent=2) if args.json else report.text())
+    return 0 if report.ok else 1
+
+
 def _cmd_grade(argv) -> int:
     from .grading import cli_grade
     return cli_grade(argv)
@@ -93,7 +166,7 @@ def _cmd_grade(argv) -> int:
 def main(argv=None) -> int:
     argv = sys.argv[1:] if argv is None else list(argv)
     if not argv or argv[0] in ("-h", "--help"):
-        print("usage: mutext {diagnose,rig,frf,demo,grade} ...\n\n"
+        print("usage: mutext {diagnose,rig,frf,demo,check,grade} ...\n\n"
               "  diagnose MODEL.toml DATA.csv [...] [--validate VAL.csv ...] [--out DIR] [--json]\n"
               "                                     what the model gets wrong, why, and the gain once fixed\n"
               "  diagnose --batch DIR [--jobs N]    every data set under DIR, summary.csv and index.html\n"
@@ -101,13 +174,17 @@ def main(argv=None) -> int:
               "  frf convert IN OUT                 FRF file CSV <-> Universal File 58 (.csv, .uff, .unv)\n"
               "  frf resonances FILE [...] [--json] resonances of measured FRFs: f_n, damping, channels\n"
               "  demo NAME [options]                run a demonstration (mutext demo --list)\n"
-              "  grade EXERCISE SUBMISSION [--json] score a submission offline\n"
+              "  check EXERCISE FILE [--json]       does your exercise file run and return the right kinds of\n"
+              "                                     values? (never whether they are right; mutext check --list)\n"
+              "  grade EXERCISE SUBMISSION [--json] score a submission offline (the instructor's grader)\n"
               "  grade EXERCISE DIR [--jobs N]      every submission in DIR: results per file, summary.csv\n")
         return 0
     cmd, rest = argv[0], argv[1:]
     try:
         if cmd == "demo":
             return _cmd_demo(rest)
+        if cmd == "check":
+            return _cmd_check(rest)
         if cmd == "grade":
             return _cmd_grade(rest)
         if cmd in COMMANDS:
@@ -120,7 +197,7 @@ def main(argv=None) -> int:
         import os
         os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
         return 0
-    print(f"mutext: unknown command '{cmd}' (expected one of diagnose, rig, frf, demo, grade)", file=sys.stderr)
+    print(f"mutext: unknown command '{cmd}' (expected one of diagnose, rig, frf, demo, check, grade)", file=sys.stderr)
     return 2
 
 
