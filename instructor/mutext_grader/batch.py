@@ -10,6 +10,14 @@ being ``DIR/results`` unless given.  A submission that could not be graded at
 all (e.g. the child could not be confined) is a row with status ``error``
 and the reason; the batch goes on.
 
+What a submission controls (its file name, its error messages) reaches
+``summary.csv`` and the table cleaned: no terminal control characters
+(:func:`mutext_grader.core.clean_text`, :func:`~mutext_grader.core.clean_name`),
+and a text cell that a spreadsheet would take for a formula (starting with
+``=``, ``+``, ``-``, ``@``, a tab or a carriage return) starts with a single
+quote (:func:`csv_cell`).  The results files keep the file name exactly
+(``extra_data.submission``; JSON is not interpreted).
+
 Parallel grading goes through the batch engine of :mod:`mutext.batch`
 (joblib; ``jobs`` workers, each starting one confined child at a time).
 Running several children at once must not give a submission a way at
@@ -33,13 +41,14 @@ from pathlib import Path
 
 import numpy as np
 
-from .core import GradingError, get_exercise, grade
+from .core import GradingError, clean_name, clean_text, get_exercise, grade
 
 __all__ = [
     "SUMMARY_HEAD",
     "SUMMARY_TAIL",
     "BatchGrades",
     "concurrency_problem",
+    "csv_cell",
     "find_submissions",
     "grade_batch",
 ]
@@ -107,7 +116,8 @@ def concurrency_problem(isolation: str, details) -> str | None:
 
 
 def _clip(text, n=300) -> str:
-    text = " ".join(str(text).split())
+    """One line of at most ``n`` characters, without control characters."""
+    text = " ".join(clean_text(text).split())
     return text if len(text) <= n else text[:n - 3] + "..."
 
 
@@ -153,7 +163,7 @@ def _grade_one(exercise: str, submission: str, time_limit: float, out_dir: str, 
     except Exception as exc:   # noqa: BLE001 - one submission must not stop the class
         msg = str(exc) if isinstance(exc, GradingError) else f"{type(exc).__name__}: {exc}"
         row.update(status="error", error=_clip(msg, 500))
-        data = {"score": 0.0, "output": f"{name} could not be graded: {row['error']}", "tests": [],
+        data = {"score": 0.0, "output": f"{clean_name(name)} could not be graded: {row['error']}", "tests": [],
                 "extra_data": {"submission": name, "status": "error", "error": row["error"]}}
     row["seconds"] = round(time.perf_counter() - t0, 2)
     try:
@@ -238,7 +248,7 @@ def grade_batch(exercise: str, directory, *, jobs: int = 1, time_limit: float = 
     def report(k, row):
         if progress is not None:
             what = (f"{row['score']:g}/{row['max_score']:g}" if row["status"] == "graded" else "not graded")
-            progress(f"{k}/{n} {row['submission']}: {what}", k / n)
+            progress(f"{k}/{n} {clean_name(row['submission'])}: {what}", k / n)
 
     rest = tasks
     if jobs != 1 and n > 1:
@@ -269,9 +279,28 @@ def grade_batch(exercise: str, directory, *, jobs: int = 1, time_limit: float = 
                and concurrency_problem(r.get("isolation", "none"), r.get("isolation_details")) is not None]
         if odd:
             res.notes.append(f"these submissions ran beside others but were not confined as the first one was "
-                             f"(see their isolation): {', '.join(odd)}")
+                             f"(see their isolation): {', '.join(clean_name(o) for o in odd)}")
     _write_summary(res)
     return res
+
+
+#: first characters that make a spreadsheet read a cell as a formula (OWASP, CSV injection)
+FORMULA_STARTS = ("=", "+", "-", "@", "\t", "\r")
+
+
+def csv_cell(value):
+    """A value as a cell of ``summary.csv``: numbers as they are; text on one line without control
+    characters (escaped, :func:`~mutext_grader.core.clean_name`) and, if it starts like a formula
+    (:data:`FORMULA_STARTS`), after a single quote, which spreadsheets show as text and do not evaluate.
+    The quote is not part of the value: a submission ``=1+1.py`` is the cell ``'=1+1.py``."""
+    if value is None:
+        return ""
+    if isinstance(value, (int, float)) and not isinstance(value, bool):
+        return value
+    text = str(value)
+    if text.startswith(FORMULA_STARTS):
+        return "'" + clean_name(text)
+    return clean_name(text)
 
 
 def _write_summary(res: BatchGrades):
@@ -281,5 +310,5 @@ def _write_summary(res: BatchGrades):
         w = csv.DictWriter(fh, fieldnames=fields, extrasaction="ignore")
         w.writeheader()
         for r in res.rows:
-            w.writerow({k: ("" if r.get(k) is None else r.get(k, "")) for k in fields})
+            w.writerow({k: csv_cell(r.get(k)) for k in fields})
     os.replace(tmp, res.summary)

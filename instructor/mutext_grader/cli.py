@@ -8,7 +8,7 @@ import math
 import sys
 from pathlib import Path
 
-from .core import EXERCISES, GradingError, grade, read_secret
+from .core import EXERCISES, GradingError, clean_name, grade, read_secret
 
 USAGE_ERROR = 2
 NOT_ISOLATED = 3
@@ -79,7 +79,7 @@ def main(argv) -> int:
         try:
             args.secret = read_secret(args.secret_file)
         except GradingError as exc:
-            print(f"mutext grade: error: {exc}", file=sys.stderr)
+            print(f"mutext grade: error: {clean_name(exc)}", file=sys.stderr)
             return USAGE_ERROR
     if Path(args.submission).is_dir():
         if args.seed is not None:
@@ -95,7 +95,7 @@ def main(argv) -> int:
         report = grade(args.exercise, args.submission, time_limit=args.time_limit,
                        require_isolation=args.require_isolation, secret=args.secret, seed=args.seed)
     except GradingError as exc:
-        print(f"mutext grade: error: {exc}", file=sys.stderr)
+        print(f"mutext grade: error: {clean_name(exc)}", file=sys.stderr)
         return USAGE_ERROR
     results = report.to_gradescope()
     if args.output:
@@ -113,8 +113,6 @@ def main(argv) -> int:
 
 def _batch(args) -> int:
     """``mutext grade EXERCISE DIR``: every submission in DIR, a results file each and summary.csv."""
-    import os
-
     from mutext.progress import ProgressLine
     from .batch import grade_batch
     if args.output:
@@ -127,20 +125,30 @@ def _batch(args) -> int:
                           progress=ProgressLine(enabled=not args.quiet), require_isolation=args.require_isolation,
                           secret=args.secret)
     except GradingError as exc:
-        print(f"mutext grade: error: {exc}", file=sys.stderr)
+        print(f"mutext grade: error: {clean_name(exc)}", file=sys.stderr)
         return USAGE_ERROR
     for note in res.notes:
-        print(f"mutext grade: note: {note}", file=sys.stderr)
+        print(f"mutext grade: note: {clean_name(note)}", file=sys.stderr)
     if args.json:
         rows = [{k: v for k, v in r.items() if k != "isolation_details"} for r in res.rows]
         print(json.dumps(rows, indent=2))
         return 1 if res.failed else 0
-    width = max(12, *(len(r["submission"]) for r in res.rows))
+    print(_table(res))
+    return 1 if res.failed else 0
+
+
+def _table(res) -> str:
+    """The class at a glance: a row per submission (indented, names and notes cleaned of control
+    characters, so a file name or an error message cannot pose as a line of the grader's own), then
+    the count, the mean and where the results are."""
+    import os
+    names = {id(r): clean_name(r["submission"]) for r in res.rows}
+    width = max(12, *(len(n) for n in names.values()))
     qids = [qid for qid, _ in res.questions]
-    print(f"Exercise {res.exercise}: {len(res.rows)} submissions in {res.directory}")
-    print(f"{'submission':<{width}}  " + " ".join(f"{q:>5}" for q in qids) + "  total  notes")
-    print(f"{'(points)':<{width}}  " + " ".join(f"{p:>5g}" for _, p in res.questions)
-          + f"  {sum(p for _, p in res.questions):>5g}")
+    lines = [f"Exercise {res.exercise}: {len(res.rows)} submissions in {clean_name(res.directory)}",
+             f"  {'submission':<{width}}  " + " ".join(f"{q:>5}" for q in qids) + "  total  notes",
+             f"  {'(points)':<{width}}  " + " ".join(f"{p:>5g}" for _, p in res.questions)
+             + f"  {sum(p for _, p in res.questions):>5g}"]
     for r in res.rows:
         if r["status"] == "graded":
             cells = " ".join(f"{r.get(q, 0):>5.2f}" for q in qids) + f"  {r['score']:>5.2f}"
@@ -148,19 +156,20 @@ def _batch(args) -> int:
         else:
             cells = " ".join(f"{'-':>5}" for _ in qids) + f"  {'-':>5}"
             notes = f"NOT GRADED: {r.get('error', '')}"
-        print(f"{r['submission']:<{width}}  {cells}  {notes[:100]}")
+        lines.append(f"  {names[id(r)]:<{width}}  {cells}  {clean_name(notes)[:100]}")
     graded = [r for r in res.rows if r["status"] == "graded"]
     line = f"{len(graded)} of {len(res.rows)} graded"
     if res.failed:
-        line += f", {len(res.failed)} could not be graded ({', '.join(r['submission'] for r in res.failed)})"
+        line += f", {len(res.failed)} could not be graded ({', '.join(names[id(r)] for r in res.failed)})"
     if graded:
         mean = sum(r["score"] for r in graded) / len(graded)
         line += f"; mean {mean:.2f} / {graded[0]['max_score']:g}"
     isol = sorted({r.get("isolation", "none") for r in graded})
-    print(line + (f"; isolation: {', '.join(isol)}" if isol else "")
-          + (f"; {res.jobs} at a time" if res.jobs != 1 else "; one at a time"))
-    print(f"results: {os.path.join(str(res.out_dir), '<submission>.json')}; summary: {res.summary}")
-    return 1 if res.failed else 0
+    lines.append(line + (f"; isolation: {', '.join(isol)}" if isol else "")
+                 + (f"; {res.jobs} at a time" if res.jobs != 1 else "; one at a time"))
+    lines.append(f"results: {clean_name(os.path.join(str(res.out_dir), '<submission>.json'))}; "
+                 f"summary: {clean_name(res.summary)}")
+    return "\n".join(lines)
 
 
 def entry() -> int:

@@ -5,6 +5,7 @@ import hashlib
 import hmac
 import importlib
 import math
+import re
 import secrets as _secrets
 import threading
 import time
@@ -18,7 +19,7 @@ from mutext.errors import MutextError
 from mutext.grading.sandbox import Job, SandboxError, run_submission
 
 __all__ = ["GradingError", "Call", "Question", "Exercise", "QuestionReport", "Report", "EXERCISES",
-           "get_exercise", "grade", "read_secret", "input_seed"]
+           "get_exercise", "grade", "read_secret", "input_seed", "clean_text", "clean_name"]
 
 
 class GradingError(MutextError):
@@ -65,8 +66,56 @@ class Exercise:
     blocked_modules: tuple = ()  # library modules that compute this exercise's answers (not importable)
 
 
+# ----------------------------------------------------------------------------------------------------------
+# text that came from a submission (error messages, violations, file names) on its way to a report
+# ----------------------------------------------------------------------------------------------------------
+
+#: terminal escape sequences: CSI (colours, cursor moves, erase), OSC (titles, hyperlinks), DCS/SOS/PM/APC
+#: strings, and the two-character ESC forms; their 8-bit C1 variants too
+_ESCAPES = re.compile(r"(?:\x1b\[|\x9b)[0-?]*[ -/]*[@-~]?"
+                      r"|(?:\x1b[\]PX^_]|[\x90\x98\x9d\x9e\x9f])[^\x07\x1b\x9c]*(?:\x07|\x1b\\|\x9c)?"
+                      r"|\x1b[ -/]*[0-~]?")
+#: what Python (str.splitlines) and terminals take for a line break
+_BREAKS = re.compile(r"\r\n|[\r\n\v\f\x1c\x1d\x1e\x85\u2028\u2029]")
+#: invisible characters that reorder or hide text (bidirectional overrides and marks)
+_BIDI = "\u061c\u200e\u200f\u202a\u202b\u202c\u202d\u202e\u2066\u2067\u2068\u2069"
+#: every control character but the newline (C0, DEL, C1), and the bidirectional ones
+_CONTROLS = re.compile("[\x00-\x09\x0b-\x1f\x7f-\x9f" + _BIDI + "]")
+
+
+def clean_text(text) -> str:
+    """``text`` with terminal escape sequences and control characters removed; line breaks (``\\r``,
+    ``\\r\\n``, vertical tab, form feed, the Unicode line separators) become ``\\n``, a tab a space.
+
+    Applied to everything a submission can influence before it is reported (error messages,
+    integrity violations); :meth:`Report.text` then indents every line of it."""
+    text = _ESCAPES.sub("", str(text))
+    text = _BREAKS.sub("\n", text).replace("\t", " ")
+    return _CONTROLS.sub("", text)
+
+
+def clean_name(text) -> str:
+    """A single-line rendering of ``text`` (a file name, a path): each control, line-break or
+    bidirectional character shown as its escape (``\\n``, ``\\x1b``, ``\\u202e``), so the name stays
+    recognisable and nothing in it acts on a terminal or starts a new line."""
+    def esc(m):
+        c = m.group(0)
+        return {"\n": "\\n", "\r": "\\r", "\t": "\\t"}.get(c) or (
+            f"\\x{ord(c):02x}" if ord(c) < 0x100 else f"\\u{ord(c):04x}")
+    return re.sub("[\x00-\x1f\x7f-\x9f\u2028\u2029" + _BIDI + "]", esc, str(text))
+
+
+def _block(text, first: str, rest: str) -> list:
+    """The lines of a cleaned ``text``: the first after ``first``, the others after ``rest``."""
+    lines = clean_text(text).split("\n")
+    return [first + lines[0]] + [rest + line for line in lines[1:]]
+
+
 @dataclass
 class QuestionReport:
+    """Points and feedback of one question.  The feedback lines are cleaned of terminal control
+    characters (:func:`clean_text`) when the report is made: they may quote the submission's own
+    error messages."""
     id: str
     name: str
     score: float
@@ -74,9 +123,15 @@ class QuestionReport:
     feedback: list
     status: str = "ok"
 
+    def __post_init__(self):
+        self.feedback = [clean_text(f) for f in self.feedback]
+        self.name = clean_name(self.name)
+
     @property
     def output(self) -> str:
-        return "\n".join(self.feedback)
+        """The feedback as one text (Gradescope's ``output`` of the test): one item per line, the
+        further lines of an item indented."""
+        return "\n".join(line for f in self.feedback for line in _block(f, "", "  "))
 
 
 @dataclass
@@ -90,6 +145,12 @@ class Report:
     isolation: str = "none"      # "uid", "landlock" or "none": how the submission's process was confined
     isolation_details: list = field(default_factory=list)
     inputs: str = ""             # where the inputs came from (the course secret, or the seed of this run)
+
+    def __post_init__(self):
+        # notes quote integrity violations (paths and module names the submission chose); the isolation
+        # details come from the child's report of its confinement
+        self.notes = [clean_text(n) for n in self.notes]
+        self.isolation_details = [clean_name(d) for d in self.isolation_details]
 
     @property
     def isolated(self) -> bool:
@@ -116,11 +177,16 @@ class Report:
         return round(sum(q.max_score for q in self.questions), 2)
 
     def to_gradescope(self) -> dict:
-        """The ``results.json`` schema of Gradescope (also written by otter-grader)."""
+        """The ``results.json`` schema of Gradescope (also written by otter-grader).
+
+        The texts meant for people (``output``, each test's ``output``) are the cleaned ones of the
+        report (no control characters; the further lines of a note or feedback item indented): Gradescope
+        shows them and ``jq -r`` prints them raw.  Numbers and the grader's own fields are as computed."""
+        notes = [line for n in self.notes for line in _block(n, "note: ", "  ")]
         return {
             "score": float(self.score),
             "execution_time": round(self.seconds, 2),
-            "output": "\n".join([f"{self.exercise}: {self.score:g} / {self.max_score:g}"] + self.notes
+            "output": "\n".join([f"{self.exercise}: {self.score:g} / {self.max_score:g}"] + notes
                                 + [self.isolation_text]),
             "isolation": self.isolation,
             "extra_data": {"isolation_details": list(self.isolation_details), "inputs": self.inputs},
@@ -129,17 +195,24 @@ class Report:
         }
 
     def text(self) -> str:
-        """Human-readable report: points and feedback per question, then the total."""
-        lines = [f"Exercise {self.exercise}: {self.title}", f"Submission: {self.submission}",
+        """Human-readable report: points and feedback per question, then the total.
+
+        Nothing a submission wrote can pose as a line of the report: its file name is shown on one line
+        with control characters escaped (:func:`clean_name`), and every line of feedback and of the
+        notes after the first is indented (the feedback by four spaces, its further lines by six), so
+        only the grader's own lines start in the first column, ``Total:`` among them."""
+        lines = [f"Exercise {self.exercise}: {self.title}", f"Submission: {clean_name(self.submission)}",
                  self.isolation_text[0].upper() + self.isolation_text[1:]]
         lines += ([f"Inputs: {self.inputs}"] if self.inputs else []) + [""]
-        lines += [f"note: {n}" for n in self.notes]
+        for n in self.notes:
+            lines += _block(n, "note: ", "      ")
         if self.notes:
             lines.append("")
         width = max(len(q.name) for q in self.questions)
         for q in self.questions:
             lines.append(f"{q.name:<{width}}  {q.score:5.2f} / {q.max_score:g}")
-            lines += [f"    {f}" for f in q.feedback]
+            for f in q.feedback:
+                lines += _block(f, "    ", "      ")
         lines += ["", f"Total: {self.score:.2f} / {self.max_score:g}"]
         return "\n".join(lines)
 
