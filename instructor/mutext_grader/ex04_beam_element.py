@@ -15,12 +15,37 @@ Questions (10 points):
 (d) ``relative_errors(...)``, 3 points: ``(omega_N - omega_exact)/omega_exact``
     for N = 2, 4, 8 elements, three beams and modes (1 point each).
 
+Inputs are drawn per run from the generator the grader passes
+(:func:`draw`): materials (steel, aluminium, titanium, brass, E and rho
+within 5 %), solid sections of 10-40 mm, a short (0.15-0.6 m) and a long
+(1.6-3 m) element in (a), beams of 0.5-2 m with 3-5 elements in (b) and 3-6
+in (c) (3 or 4 modes), the modes of (d) (pinned-pinned mode 1 or 2,
+cantilever mode 1, cantilever mode 2 or 3), and the order of the calls.
+:func:`prepare` builds the references of the same draw while the child runs.
+
 The references are computed with :mod:`mutext.rotor` (Timoshenko shaft
 elements with shear deformation and rotary inertia switched off, which is
 the Euler-Bernoulli element) and the exact Euler-Bernoulli frequencies
 :math:`\omega_n = (\beta_n L)^2\sqrt{EI/(\rho A L^4)}`.  Submissions may not
-import :mod:`mutext.rotor` (it computes the answers).  Feedback names the
-usual mistakes: a lumped instead of a consistent mass matrix, a factor
+import :mod:`mutext.rotor` (it computes the answers).
+
+What earns points: matrices and frequencies within 1e-6 (relative to the
+largest entry) of the reference, the errors of (d) within 1e-4 relative
+plus 1e-9; half of a beam's points in (b) for the right free-beam matrices
+(supports not applied) or the right beam in another DOF order.  Zeros,
+identity matrices, constants and the closed-form frequencies in (c) (the
+finite-element ones are asked) earn nothing
+(``tests/grading_submissions/trivial/ex04_*.py``).  Sizes are checked before
+anything is computed: an array of another shape than asked, e.g. matrices
+far larger than ``2N x 2N``, scores 0 for that call with a message and is
+never factorised.  The errors of (d) are dimensionless: they depend only on
+the support and the mode, not on the drawn beam, so a table of them
+(6 cases x 3 numbers) copied from a working solution would pass (d).
+
+Feedback names the call by number with its support, number of elements and
+modes (arguments, not answers) and the usual mistakes, never a reference
+value (a factor is quoted only when it is a simple ratio such as 1/2, or a
+power of L): a lumped instead of a consistent mass matrix, a factor
 :math:`L` missing in the rotational terms, a wrong prefactor, another DOF
 order or rotation sign, supports not applied (rigid-body zero frequencies),
 Hz instead of rad/s, an inaccurate analytic value.
@@ -44,9 +69,19 @@ ATOL_ERR = 1e-9        # ... plus this absolute slack (the errors reach 1e-6)
 
 SUPPORT_TEXT = {"pinned": "pinned-pinned", "cantilever": "cantilever"}
 
-#: materials and solid circular sections (diameter d) of the test beams, SI
-STEEL = dict(E=2.1e11, rho=7800.0, d=0.02)
-ALUMINIUM = dict(E=7.0e10, rho=2700.0, d=0.03)
+#: (name, E Pa, rho kg/m^3) of the materials a test beam is drawn from; E and rho then vary by +-5 %
+MATERIALS = (("steel", 2.1e11, 7800.0), ("aluminium", 7.0e10, 2700.0), ("titanium", 1.1e11, 4500.0),
+             ("brass", 1.0e11, 8500.0))
+DIAMETER = (0.010, 0.040)                    # m, solid circular sections
+#: element lengths (m) of the two parameter sets of (a): one short, one long, both far from 1 m, so that a
+#: wrong power of L in a prefactor or in the rotational terms shows
+ELEMENT_LENGTHS = ((0.15, 0.6), (1.6, 3.0))
+BEAM_LENGTH = (0.5, 2.0)                     # m, the beams of (b), (c), (d)
+ELEMENTS_B = (3, 5)                          # elements of the beams of (b) (inclusive range)
+ELEMENTS_C = (3, 6)                          # ... and of (c)
+MODES_C = (3, 4)                             # frequencies asked in (c)
+#: (support, modes one is drawn from) of the three calls of (d), shuffled
+D_CASES = (("pinned", (1, 2)), ("cantilever", (1,)), ("cantilever", (2, 3)))
 DOF_NAMES = ["w1", "theta1", "w2", "theta2"]
 ROT = np.array([0, 1, 0, 1])          # 1 where the element DOF is a rotation
 
@@ -60,6 +95,38 @@ def beam_args(mat):
     """``(E, I, rho, A)`` of a material dict, as the student's functions take them."""
     A, I = section(mat["d"])
     return mat["E"], I, mat["rho"], A
+
+
+def _material(rng):
+    _, E, rho = MATERIALS[int(rng.integers(len(MATERIALS)))]
+    return dict(E=float(f"{E * rng.uniform(0.95, 1.05):.3g}"), rho=float(round(rho * rng.uniform(0.95, 1.05))),
+                d=round(float(rng.uniform(*DIAMETER)), 4))
+
+
+def _length(rng, lo_hi):
+    return round(float(math.exp(rng.uniform(*np.log(lo_hi)))), 3)
+
+
+def draw(rng):
+    """The graded inputs of one run, from the numpy Generator ``rng``.
+
+    Returns a dict: ``"a"``, two ``(material, L)`` (one short and one long element, shuffled); ``"b"``,
+    ``(n, length, material, support)`` of a pinned-pinned and a cantilever beam (shuffled); ``"c"``,
+    ``(n, length, material, support, n_modes)`` likewise; ``"d"``, three ``(length, material, support,
+    mode)`` (:data:`D_CASES`, shuffled).  A material is a dict ``E``, ``rho``, ``d`` (the section's
+    diameter, which the reference needs; the child gets ``I`` and ``A``).
+    """
+    a = [(_material(rng), _length(rng, lo_hi)) for lo_hi in ELEMENT_LENGTHS]
+    a = [a[i] for i in rng.permutation(2)]
+    b = [(int(rng.integers(ELEMENTS_B[0], ELEMENTS_B[1] + 1)), _length(rng, BEAM_LENGTH), _material(rng), sup)
+         for sup in ("pinned", "cantilever")]
+    b = [b[i] for i in rng.permutation(2)]
+    c = [(int(rng.integers(ELEMENTS_C[0], ELEMENTS_C[1] + 1)), _length(rng, BEAM_LENGTH), _material(rng), sup,
+          int(rng.integers(MODES_C[0], MODES_C[1] + 1))) for sup in ("pinned", "cantilever")]
+    c = [c[i] for i in rng.permutation(2)]
+    d = [(_length(rng, BEAM_LENGTH), _material(rng), sup, int(rng.choice(modes))) for sup, modes in D_CASES]
+    d = [d[i] for i in rng.permutation(3)]
+    return {"a": a, "b": b, "c": c, "d": d}
 
 
 # ----------------------------------------------------------------------------
@@ -145,9 +212,14 @@ def _lumped_free_free(n, length, E, d, rho):
 
 
 def prepare(rng=None):
-    """Build the references of all calls (the CasADi models) while the child runs."""
-    for n, length, mat in ((3, 1.2, STEEL), (4, 0.8, ALUMINIUM), (4, 1.2, STEEL), (5, 0.8, ALUMINIUM),
-                           (2, 1.2, STEEL), (8, 1.2, STEEL), (2, 0.8, ALUMINIUM), (8, 0.8, ALUMINIUM)):
+    """Build the references of this run's calls (the CasADi models) while the child runs; ``rng`` is
+    seeded as the one :func:`questions` gets, so :func:`draw` gives the same beams."""
+    if rng is None:
+        return
+    cases = draw(rng)
+    beams = [(n, length, mat) for n, length, mat, *_ in cases["b"] + cases["c"]]
+    beams += [(n, length, mat) for length, mat, *_ in cases["d"] for n in (2, 4, 8)]
+    for n, length, mat in beams:
         free_free(n, length, mat["E"], mat["d"], mat["rho"])
 
 
@@ -204,9 +276,21 @@ def _rotation_pattern(X, Y, L):
 
 
 def _worst_entry(X, Y, names):
+    """Where ``X`` differs most from ``Y``, and which way (the reference value is not given)."""
     err = np.abs(X - Y)
     i, j = np.unravel_index(int(np.nanargmax(np.where(np.isfinite(err), err, np.inf))), X.shape)
-    return f"entry ({names[i]}, {names[j]}): expected {fmt(Y[i, j])}, got {fmt(X[i, j])}"
+    how = "not finite" if not np.isfinite(X[i, j]) else ("too large" if X[i, j] > Y[i, j] else "too small")
+    return f"the largest difference is in entry ({names[i]}, {names[j]}), yours is {how}"
+
+
+def _simple_factor(c):
+    """``c`` as text if it is a simple ratio ``p/q`` (|p|, q <= 12), the trace of a known slip; else None,
+    since an arbitrary factor would tell the reference."""
+    for q in range(1, 13):
+        p = round(c * q)
+        if p and abs(p) <= 12 and abs(c * q - p) <= 1e-6 * abs(p):
+            return fmt(p / q)
+    return None
 
 
 def _power_text(k):
@@ -252,7 +336,10 @@ def _diagnose_element(X, Y, L, which, Mr=None):
                      else f" (e.g. rho A L^{1 + k}/420 instead of rho A L/420)")
             return (f"the {name} is {_power_text(k)} times the expected one: check the power of L in the "
                     f"prefactor {pref}{extra}")
-        return f"the {name} is {fmt(c)} times the expected one: check the prefactor {pref}"
+        nice = _simple_factor(c)
+        if nice is not None:
+            return f"the {name} is {nice} times the expected one: check the prefactor {pref}"
+        return f"the {name} is proportional to the expected one with another factor: check the prefactor {pref}"
     pat = _rotation_pattern(X, Y, L)
     if pat is not None:
         c, p = pat
@@ -264,9 +351,11 @@ def _diagnose_element(X, Y, L, which, Mr=None):
             msg = (f"the rotational terms of the {name} have an extra factor {_power_text(p)} "
                    f"(the entries of the theta rows and columns should be {terms})")
         if abs(c - 1) > 1e-6:
-            msg += f"; moreover the prefactor is {fmt(c)} times {pref}"
+            nice = _simple_factor(c)
+            msg += (f"; moreover the prefactor is {nice} times {pref}" if nice is not None
+                    else f"; moreover the prefactor {pref} is not right")
         return msg
-    fb = f"the {name} differs from the expected one: {_worst_entry(X, Y, DOF_NAMES)}"
+    fb = f"the {name} is not right: {_worst_entry(X, Y, DOF_NAMES)}"
     if not close(X, X.T):
         fb += f"; note that your {name} is not symmetric"
     return fb
@@ -319,9 +408,13 @@ def _check_assembly(outcomes, calls):
             fb.append(f"{tag} assemble() must return the pair (K, M) of square arrays, got an array of shape "
                       f"{V.shape}")
             continue
+        size = V.shape[1]
+        if size > 2 * (2 * n + 2):
+            fb.append(f"{tag} the matrices are {size}x{size}, far larger than the {2 * n}x{2 * n} asked for "
+                      f"{n} elements (2 DOFs per node, {n + 1} nodes, 2 fixed by the supports): not analysed")
+            continue
         Ks, Ms = V
         K, M = supported(n, length, E, d, rho, support)
-        size = Ks.shape[0]
         fixed = constrained(n, support)
         if close(Ks, K) and close(Ms, M):
             score += 2 * per
@@ -373,8 +466,8 @@ def _check_assembly(outcomes, calls):
                 n_ok += 1
             else:
                 names = [_global_name(k) for k in np.setdiff1d(np.arange(2 * (n + 1)), fixed)]
-                fb.append(f"{tag} {which} differs: {_worst_entry(X, Y, names)}; check the element matrices of (a) "
-                          "and that overlapping entries are added")
+                fb.append(f"{tag} {which} is not right: {_worst_entry(X, Y, names)}; check the element matrices "
+                          "of (a) and that overlapping entries are added")
     if n_ok == 2 * len(calls):
         fb.insert(0, "correct: K and M of both beams match")
     return score, fb
@@ -394,11 +487,11 @@ def _check_frequencies(outcomes, calls):
     for call, tag, w in returned(outcomes, calls, fb, as_array, "natural_frequencies()"):
         n, length, E, I, rho, A, support, n_modes = call.args
         d = call.kwargs_ref["d"]
-        ref = frequencies(*supported(n, length, E, d, rho, support), n_modes)
         w = w.ravel()
-        if w.size != n_modes:
+        if w.size != n_modes:          # before any computation: a huge array is never analysed
             fb.append(f"{tag} expected the {n_modes} lowest frequencies, got {w.size} numbers")
             continue
+        ref = frequencies(*supported(n, length, E, d, rho, support), n_modes)
         if close(w, ref):
             score += per
             n_ok += 1
@@ -431,9 +524,9 @@ def _check_frequencies(outcomes, calls):
                     break
         if msg is None:
             k = int(np.nanargmax(np.abs(w - ref) / ref))
-            msg = (f"mode {k + 1}: expected {ref[k]:.6g} rad/s, got {fmt(w[k])} rad/s; check (a) and (b) "
-                   "(use scipy.linalg.eigh(K, M))")
-        fb.append(f"{tag} {msg}; expected {', '.join(f'{x:.5g}' for x in ref)} rad/s")
+            msg = (f"mode {k + 1} is furthest off (yours is {'too high' if w[k] > ref[k] else 'too low'}); "
+                   "check (a) and (b) (use scipy.linalg.eigh(K, M))")
+        fb.append(f"{tag} {msg}")
     if n_ok == len(calls):
         fb.insert(0, "correct: the frequencies of both beams match")
     return score, fb
@@ -459,9 +552,8 @@ def _diagnose_errors(e, ref, length, E, d, rho, support, mode):
         return "the error has the wrong reference: return (omega_N - omega_exact) / omega_exact"
     if _errors_match(e, w_fe - exact):
         return "this is the absolute error in rad/s: divide by the exact frequency"
-    lumped = np.array([frequencies(*reduce(*_lumped_free_free(n, length, E, d, rho), constrained(n, support)))
-                       [mode - 1] / exact - 1 for n in (2, 4, 8)])
-    if _errors_match(e, lumped):
+    lumped = _lumped_errors(length, E, d, rho, support, mode, exact)
+    if lumped is not None and _errors_match(e, lumped):
         return "these are the errors of a lumped mass matrix; use the consistent mass matrix of (a)"
     if np.all(np.isfinite(e)) and np.all(e != -1):
         # the submission's exact value, assuming its finite-element frequencies are right
@@ -482,10 +574,13 @@ def _diagnose_errors(e, ref, length, E, d, rho, support, mode):
                     return (f"the analytic value is that of mode {m}, not mode {mode} "
                             "(mode numbers start at 1; Python indices at 0)")
             if abs(c - 1) < 1e-2:
-                return (f"your analytic frequency is {abs(c - 1) * 1e6:.3g} ppm off: use beta L to at least 10 "
-                        f"digits (beta_{mode} L = {bl[mode - 1]:.12g}); with 8 elements the finite-element error "
-                        f"is only {ref[-1]:.2g}")
-            return f"your analytic frequency is {fmt(c)} times the exact one, (beta L)^2 sqrt(EI/(rho A L^4))"
+                return (f"your analytic frequency is about {_one_digit(abs(c - 1) * 1e6)} ppm off: use beta L to "
+                        f"at least 10 digits (beta_{mode} L = {bl[mode - 1]:.12g}); with 8 elements the "
+                        "finite-element error is smaller than that")
+            nice = _simple_factor(c)
+            return ((f"your analytic frequency is {nice} times the exact one" if nice is not None else
+                     "your analytic frequency is off by a constant factor")
+                    + ", (beta L)^2 sqrt(EI/(rho A L^4))")
         if np.all(np.abs(e) < np.abs(ref) * 1e-3 + 1e-12):
             return "the errors are (nearly) zero: compare the finite-element value with the exact formula"
         if np.all(e < 0):
@@ -493,8 +588,26 @@ def _diagnose_errors(e, ref, length, E, d, rho, support, mode):
                     "lie above the exact ones (a Rayleigh-Ritz upper bound); a lumped mass matrix or a wrong "
                     "analytic value gives negative errors")
     k = int(np.argmax(np.abs(e - ref) / (np.abs(ref) + ATOL_ERR)))
-    return (f"N = {(2, 4, 8)[k]}: expected {ref[k]:.6g}, got {fmt(e[k])}; the finite-element frequencies "
-            "(see (c)) or the analytic value are off")
+    return (f"N = {(2, 4, 8)[k]} is furthest off; the finite-element frequencies (see (c)) or the analytic "
+            "value are off")
+
+
+def _one_digit(x):
+    """``x`` rounded to one significant digit, as text (the size of a mistake, not a reference)."""
+    if not (math.isfinite(x) and x > 0):
+        return fmt(x)
+    return f"{round(x, -int(math.floor(math.log10(x)))):g}"
+
+
+def _lumped_errors(length, E, d, rho, support, mode, exact):
+    """The errors of (d) with a lumped mass matrix, or None where it has fewer than ``mode`` finite modes."""
+    out = []
+    for n in (2, 4, 8):
+        w = frequencies(*reduce(*_lumped_free_free(n, length, E, d, rho), constrained(n, support)))
+        if w.size < mode:
+            return None
+        out.append(w[mode - 1] / exact - 1)
+    return np.array(out)
 
 
 def _check_errors(outcomes, calls):
@@ -504,17 +617,16 @@ def _check_errors(outcomes, calls):
         length, E, I, rho, A, support = call.args
         mode = call.kwargs["mode"]
         d = call.kwargs_ref["d"]
-        ref = reference_errors(length, E, d, rho, support, mode)
         e = e.ravel()
-        if e.size != 3:
+        if e.size != 3:                # before any computation: a huge array is never analysed
             fb.append(f"{tag} expected 3 relative errors (N = 2, 4, 8), got {e.size} numbers")
             continue
+        ref = reference_errors(length, E, d, rho, support, mode)
         if _errors_match(e, ref):
             score += per
             n_ok += 1
             continue
-        fb.append(f"{tag} " + _diagnose_errors(e, ref, length, E, d, rho, support, mode)
-                  + f"; expected {', '.join(f'{x:.4g}' for x in ref)}")
+        fb.append(f"{tag} " + _diagnose_errors(e, ref, length, E, d, rho, support, mode))
     if n_ok == len(calls):
         rates = []
         for call in calls:
@@ -543,23 +655,20 @@ def _beam_call(label, n, length, mat, support, *extra, kwargs=None):
 
 
 def questions(rng=None):
-    """The four questions with their test inputs."""
+    """The four questions with inputs drawn from ``rng`` (:func:`draw`; a fresh generator if None).
+
+    The labels name the support, the number of elements and the modes asked (arguments, not answers)."""
+    cases = draw(np.random.default_rng() if rng is None else rng)
     a_calls = []
-    for label, mat, L in (("steel, d = 20 mm, L = 0.3 m", STEEL, 0.3),
-                          ("aluminium, d = 30 mm, L = 2.5 m", ALUMINIUM, 2.5)):
+    for i, (mat, L) in enumerate(cases["a"]):
         E, I, rho, A = beam_args(mat)
-        a_calls.append(_Call(label, [E, I, rho, A, L], d=mat["d"]))
-    b_calls = [_beam_call("pinned-pinned steel beam, 1.2 m, 3 elements", 3, 1.2, STEEL, "pinned"),
-               _beam_call("cantilever aluminium beam, 0.8 m, 4 elements", 4, 0.8, ALUMINIUM, "cantilever")]
-    c_calls = [_beam_call("pinned-pinned steel beam, 1.2 m, 4 elements, 3 modes", 4, 1.2, STEEL, "pinned", 3),
-               _beam_call("cantilever aluminium beam, 0.8 m, 5 elements, 4 modes", 5, 0.8, ALUMINIUM,
-                          "cantilever", 4)]
-    d_calls = [_beam_call("pinned-pinned steel beam, 1.2 m, mode 1", None, 1.2, STEEL, "pinned",
-                          kwargs={"mode": 1}),
-               _beam_call("cantilever aluminium beam, 0.8 m, mode 1", None, 0.8, ALUMINIUM, "cantilever",
-                          kwargs={"mode": 1}),
-               _beam_call("cantilever steel beam, 1.2 m, mode 2", None, 1.2, STEEL, "cantilever",
-                          kwargs={"mode": 2})]
+        a_calls.append(_Call(f"element {i + 1} of {len(cases['a'])}", [E, I, rho, A, L], d=mat["d"]))
+    b_calls = [_beam_call(f"beam {i + 1} of {len(cases['b'])}: {SUPPORT_TEXT[sup]}, {n} elements", n, length, mat,
+                          sup) for i, (n, length, mat, sup) in enumerate(cases["b"])]
+    c_calls = [_beam_call(f"beam {i + 1} of {len(cases['c'])}: {SUPPORT_TEXT[sup]}, {n} elements, {k} modes", n,
+                          length, mat, sup, k) for i, (n, length, mat, sup, k) in enumerate(cases["c"])]
+    d_calls = [_beam_call(f"beam {i + 1} of {len(cases['d'])}: {SUPPORT_TEXT[sup]}, mode {mode}", None, length, mat,
+                          sup, kwargs={"mode": mode}) for i, (length, mat, sup, mode) in enumerate(cases["d"])]
     return [
         Question("a", "element_matrices", "element stiffness and consistent mass matrices", POINTS["a"], "array",
                  a_calls, lambda oc: _check_element(oc, a_calls)),
