@@ -468,9 +468,18 @@ def hidden_effect_data(example: str = "three_mass", seed: int = 0, *, kind: str 
         raise ModelError(f"hide: noise must be a relative level in (0, 0.2], got {noise!r}")
     if isinstance(seed, bool) or not isinstance(seed, (int, np.integer)) or seed < 0:
         raise ModelError(f"hide: seed must be a non-negative integer, got {seed!r}")
-    with open(path, "rb") as fh:
-        doc = tomllib.load(fh)
+    try:
+        with open(path, "rb") as fh:
+            doc = tomllib.load(fh)
+    except tomllib.TOMLDecodeError as exc:
+        raise ModelError(f"{path}: not a valid TOML file ({exc})") from None
+    except OSError as exc:
+        raise ModelError(f"{path}: cannot read the model file ({exc.strerror or exc})") from None
     rotor = "shaft" in doc or "station" in doc
+    if not rotor:
+        # the model parser names the file, table and key of a malformed chain before the plain assembly reads it
+        from .rotor import load_model
+        load_model(path)
     kinds = _ROTOR_KINDS if rotor else _LUMPED_KINDS
     if kind is not None and kind not in kinds + ("none",):
         raise ModelError(f"hide: kind '{kind}' is not available for this model; kinds: {', '.join(kinds)}, none")

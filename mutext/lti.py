@@ -50,15 +50,59 @@ def blas_single_thread():
 
 
 def ss(A, B, C, D, *, inputs=None, outputs=None, states=None, name=None) -> ct.StateSpace:
-    """Continuous-time state space with 2-D float matrices (empty blocks allowed)."""
-    _check_real(A, B, C, D, what=name or "system")
-    A, B, C, D = (np.real(X) if np.iscomplexobj(X) else X for X in (A, B, C, D))
-    A = np.atleast_2d(np.asarray(A, dtype=float))
-    n = A.shape[0] if A.size else 0
-    B = np.asarray(B, dtype=float).reshape(n, -1) if n else np.zeros((0, np.asarray(D).shape[1] if np.ndim(D) == 2 else 0))
-    D = np.atleast_2d(np.asarray(D, dtype=float))
-    C = np.asarray(C, dtype=float).reshape(D.shape[0], n) if n else np.zeros((D.shape[0], 0))
-    A = A.reshape(n, n)
+    """Continuous-time state space with 2-D float matrices (empty blocks allowed).
+
+    Raises :class:`ModelError` naming the matrix when an entry is not a number
+    (a string, ``None``) or the sizes do not fit together: ``A`` is n x n,
+    ``B`` n x m, ``C`` p x n, ``D`` p x m.
+    """
+    what = name or "system"
+    _check_real(A, B, C, D, what=what)
+    mats = []
+    for label, X in zip("ABCD", (A, B, C, D)):
+        arr = np.asarray(X) if not isinstance(X, np.ndarray) else X
+        if arr.size and (arr.dtype == object or arr.dtype.kind in "USV"):
+            numbers = (int, float, np.integer, np.floating)
+            odd = [v for v in np.ravel(arr) if not isinstance(v, numbers)][:1]
+            bad = odd[0] if odd else None
+            if odd:
+                raise ModelError(f"{what}.{label} has an entry that is not a number ({bad!r}): every entry of "
+                                 "A, B, C and D must be a real number")
+        try:
+            arr = np.real(arr) if np.iscomplexobj(arr) else arr
+            mats.append(np.asarray(arr, dtype=float))
+        except (TypeError, ValueError) as exc:
+            raise ModelError(f"{what}.{label} is not a matrix of real numbers ({exc})") from None
+    A, B, C, D = mats
+    for label, X in zip("ABCD", mats):
+        if X.ndim > 2:
+            raise ModelError(f"{what}.{label} has {X.ndim} dimensions (shape {X.shape}); a state-space matrix "
+                             "is 2-D")
+    if A.ndim < 2 and A.size > 1:
+        raise ModelError(f"{what}.A has shape {A.shape}; it must be a square n x n matrix (a 1-D array is "
+                         "ambiguous)")
+    A = np.atleast_2d(A) if A.size else np.zeros((0, 0))
+    if A.shape[0] != A.shape[1]:
+        raise ModelError(f"{what}.A has shape {A.shape}; it must be square (n x n)")
+    n = A.shape[0]
+    D = np.atleast_2d(D) if D.size or D.ndim == 2 else np.zeros((0, 0))
+    if n:
+        if B.ndim < 2:
+            B = B.reshape(n, -1) if B.size % n == 0 and B.size else B
+        if C.ndim < 2 and C.size:
+            C = C.reshape(-1, n) if C.size % n == 0 else C
+        if B.ndim != 2 or B.shape[0] != n:
+            raise ModelError(f"{what}.B has shape {B.shape}; with A {n} x {n} it needs {n} rows")
+        if C.ndim != 2 or C.shape[1] != n:
+            raise ModelError(f"{what}.C has shape {C.shape}; with A {n} x {n} it needs {n} columns")
+        if D.size == 0 and D.shape != (C.shape[0], B.shape[1]):
+            D = np.zeros((C.shape[0], B.shape[1]))
+        if D.shape != (C.shape[0], B.shape[1]):
+            raise ModelError(f"{what}.D has shape {D.shape}; with B {B.shape} and C {C.shape} it must be "
+                             f"{C.shape[0]} x {B.shape[1]}")
+    else:
+        B = np.zeros((0, D.shape[1]))
+        C = np.zeros((D.shape[0], 0))
     kw = {}
     if inputs is not None:
         kw["inputs"] = list(inputs)
@@ -78,7 +122,12 @@ def as_ss(sys, what: str = "system") -> ct.StateSpace:
         _check_real(sys.A, sys.B, sys.C, sys.D, what=what)
         out = sys
     elif isinstance(sys, ct.TransferFunction):
-        out = ct.ss(sys)
+        try:
+            out = ct.ss(sys)
+        except ValueError as exc:
+            raise ModelError(f"{what}: this transfer function has no state-space form ({exc}); an improper "
+                             "transfer function (numerator degree above the denominator's) has no finite "
+                             "H-infinity norm or state-space realisation") from None
     elif isinstance(sys, (tuple, list)) and len(sys) == 4:
         _check_real(*sys, what=what)
         try:
@@ -400,7 +449,8 @@ def freqresp(sys, omega) -> np.ndarray:
     python-control's).
     """
     sys = as_ss(sys)
-    omega = np.atleast_1d(np.asarray(omega, dtype=float))
+    check_finite(sys)
+    omega = _omega_vector(omega, "freqresp")
     A, B, C, D = (np.asarray(X, float) for X in (sys.A, sys.B, sys.C, sys.D))
     out = np.empty((D.shape[0], D.shape[1], omega.size), dtype=complex)
     if A.size == 0:
@@ -418,9 +468,34 @@ def freqresp(sys, omega) -> np.ndarray:
     if n >= _MODAL_MIN_STATES:
         todo = _modal_solve(A, B, omega, X)
     if todo.any():
-        X[todo] = _direct_solve(A, B, omega[todo])
+        try:
+            X[todo] = _direct_solve(A, B, omega[todo])
+        except np.linalg.LinAlgError:
+            lam = np.linalg.eigvals(A)
+            hit = [w for w in omega[todo] if np.min(np.abs(1j * w - lam)) <= 1e-12 * max(1.0, abs(w))]
+            where = f" at {hit[0]:g} rad/s" if hit else ""
+            raise ModelError(f"freqresp: the system has a pole on the imaginary axis{where}, on the frequency "
+                             "grid (an undamped mode or an integrator at 0): its response is infinite there; "
+                             "leave that frequency out or add damping") from None
     out[:] = np.moveaxis(C[None] @ X, 0, -1) + D[:, :, None]
     return out
+
+
+def _omega_vector(omega, what: str) -> np.ndarray:
+    """Frequencies as a 1-D array of finite real numbers (rad/s), or a :class:`ModelError` saying what is wrong."""
+    try:
+        w = np.asarray(omega, dtype=float)
+    except (TypeError, ValueError):
+        raise ModelError(f"{what}: the frequencies must be real numbers (rad/s), got {type(omega).__name__}") \
+            from None
+    if w.ndim > 1:
+        raise ModelError(f"{what}: the frequencies must be a 1-D array (rad/s), got shape {w.shape}")
+    w = np.atleast_1d(w)
+    if not np.all(np.isfinite(w)):
+        bad = w[~np.isfinite(w)][0]
+        raise ModelError(f"{what}: the frequencies must be finite, got {bad} at index "
+                         f"{int(np.argmax(~np.isfinite(w)))}")
+    return w
 
 
 #: from this many states up the modal route is tried first (below it LU is as cheap)
@@ -552,6 +627,9 @@ def stability(sys, margin: float = 0.0) -> Stability:
         The verdict (truthy when stable), the poles, their thresholds and a
         message naming the deciding pole.
     """
+    if isinstance(margin, bool) or not isinstance(margin, (int, float, np.integer, np.floating)) \
+            or not np.isfinite(margin) or margin < 0:
+        raise ModelError(f"stability: margin must be a finite number >= 0 (rad/s), got {margin!r}")
     sys = as_ss(sys)
     if sys.nstates == 0:
         return Stability(True, np.zeros(0, complex), np.zeros(0), complex(np.nan), -np.inf,
@@ -714,9 +792,32 @@ def hinf_norm(sys, rtol: float = 1e-10, *, require_stable: bool = True) -> HinfN
         If True (default), an unstable system has norm ``inf``.  If False the
         L-infinity norm (peak gain on the imaginary axis) is returned, which is
         finite when no pole lies on the imaginary axis.
+
+    The gain is computed on ``G / s`` with ``s`` the size of ``B``, ``C`` and
+    ``D`` (an exact rescaling), so systems scaled by 1e-160 or 1e300 give their
+    norm, not an overflow; a norm beyond the largest double is ``inf``.
     """
+    if isinstance(rtol, bool) or not isinstance(rtol, (int, float, np.integer, np.floating)) \
+            or not np.isfinite(rtol) or not 0 < rtol < 1:
+        raise ModelError(f"hinf_norm: rtol must be a number between 0 and 1 (exclusive), got {rtol!r}")
     sys = as_ss(sys)
     check_finite(sys)
+    B0, C0, D0 = (np.asarray(X, float) for X in (sys.B, sys.C, sys.D))
+    sB = float(np.max(np.abs(B0))) if B0.size else 0.0
+    sC = float(np.max(np.abs(C0))) if C0.size else 0.0
+    sD0 = float(np.max(np.abs(D0))) if D0.size else 0.0
+    logs = [x for x in ((np.log(sB) + np.log(sC)) if sB > 0 and sC > 0 else -np.inf,
+                        np.log(sD0) if sD0 > 0 else -np.inf) if np.isfinite(x)]
+    if logs and abs(max(logs)) > 30:
+        # rescale to gains of order one: G = exp(ls) G', exactly, with |B'|, |C'|, |D'| <= 1
+        ls = max(logs)
+        Bs = B0 / sB if sB > 0 else B0
+        Cs = C0 / sC * np.exp(np.log(sB) + np.log(sC) - ls) if sB > 0 and sC > 0 else C0 * 0.0
+        Ds = D0 * np.exp(-ls)
+        r = hinf_norm(ss(sys.A, Bs, Cs, Ds), rtol, require_stable=require_stable)
+        with np.errstate(over="ignore"):
+            f = np.exp(ls)
+            return HinfNorm(float(r.value * f), r.frequency, float(r.lower * f), float(r.upper * f), r.iterations)
     D = np.asarray(sys.D, float)
     sD = np.linalg.norm(D, 2) if D.size else 0.0
     if sys.nstates == 0:

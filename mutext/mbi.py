@@ -185,8 +185,14 @@ def mbi_plant(true, engineering, *, excitation: str, measurement: str, control_i
         An unstable true or engineering system (the identification compares
         responses, which must exist).
     """
-    if not (np.isfinite(Ww) and Ww > 0 and np.isfinite(Wz) and Wz > 0):
-        raise ModelError(f"Ww and Wz must be positive and finite, got Ww={Ww}, Wz={Wz}")
+    for name, v in (("Ww", Ww), ("Wz", Wz)):
+        if isinstance(v, bool) or not isinstance(v, (int, float, np.integer, np.floating)) \
+                or not np.isfinite(v) or v <= 0:
+            raise ModelError(f"{name} must be a positive, finite number, got {v!r}")
+    if regularization is not None and (
+            isinstance(regularization, bool) or not isinstance(regularization, (int, float, np.integer, np.floating))
+            or not np.isfinite(regularization) or regularization < 0):
+        raise ModelError(f"regularization must be a finite number >= 0 (or None for none), got {regularization!r}")
     if Wz_shape is not None and not isinstance(Wz_shape, MagnitudeFit):
         raise ModelError("Wz_shape must be a mutext.frfit.MagnitudeFit (e.g. from spread_weight), "
                          f"got {type(Wz_shape).__name__}")
@@ -928,6 +934,17 @@ def identify(true, engineering, *, excitation: str, measurement: str, control_in
     if floor.value > 0:
         say(f"W_z floor {floor.value:.4g} (spread of {floor.samples} true systems at {floor.omega:.4g} rad/s)")
     opts = {"max_iter": 4, "out": None if out is None else out}
+    if dk_options is not None and not isinstance(dk_options, dict):
+        raise ModelError(f"dk_options must be a dict of dk_iteration's keyword arguments, got "
+                         f"{type(dk_options).__name__}")
+    import inspect
+
+    from .dk import dk_iteration
+    known = set(inspect.signature(dk_iteration).parameters) - {"P", "structure", "nmeas", "ncon"}
+    unknown = sorted(set(dk_options or {}) - known)
+    if unknown:
+        raise ModelError(f"dk_options: unknown option(s) {', '.join(map(repr, unknown))}; dk_iteration takes "
+                         f"{', '.join(sorted(known))}")
     opts.update(dk_options or {})
     kw["Wz_shape"] = shape
     search = _search_wz(lambda w: mbi_plant(true, engineering, Wz=w, **kw), Wz, floor, omega, opts, tol,
@@ -1189,6 +1206,10 @@ def relative_error(K, reference, omega, weight=None) -> float:
     D = impedance_response(reference, omega) if isinstance(reference, dict) else np.asarray(reference, complex)
     Kj = np.asarray(K, complex) if isinstance(K, np.ndarray) else freqresp(as_ss(K), omega)[0, 0]
     w2 = np.ones_like(omega) if weight is None else np.asarray(weight, float) ** 2
+    for name, arr in (("K", Kj), ("reference", D), ("weight", w2)):
+        if np.shape(arr) != omega.shape:
+            raise ModelError(f"relative_error: {name} has shape {np.shape(arr)}; it must have one value per "
+                             f"frequency ({omega.shape})")
     return float(np.sqrt(np.sum(w2 * np.abs(Kj - D) ** 2 / np.abs(D) ** 2) / np.sum(w2)))
 
 

@@ -441,6 +441,12 @@ def write_frf(path, frf: FRF, *, output_unit: str = "m") -> Path:
     if frf.input_station is None or frf.output_station is None:
         raise ModelError(f"write_frf {path}: input_station and output_station must be set "
                          f"(got {frf.input_station}, {frf.output_station})")
+    for name in ("input_station", "output_station"):
+        v = getattr(frf, name)
+        whole = isinstance(v, (int, np.integer)) or (isinstance(v, (float, np.floating)) and float(v).is_integer())
+        if isinstance(v, bool) or not whole:
+            raise ModelError(f"write_frf {path}: {name} must be a whole station number, got {v!r} "
+                             "(it would be written rounded)")
     units = OUTPUT_UNITS[frf.output_quantity]
     if output_unit not in units:
         raise ModelError(f"write_frf {path}: unknown {frf.output_quantity} unit "
@@ -526,7 +532,9 @@ def read_frfs(paths_or_glob, *, mapping=None, units=None) -> list[FRF]:
         if not paths:
             raise ModelError("read_frfs: empty list of paths")
     out: list[FRF] = []
-    for p in paths:
+    for k, p in enumerate(paths):
+        if not isinstance(p, (str, os.PathLike)):
+            raise ModelError(f"read_frfs: entry {k} of the list is {type(p).__name__}, not a path")
         if is_uff_file(p):
             out.extend(read_uff58(p, mapping=mapping, units=units))
         else:

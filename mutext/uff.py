@@ -587,7 +587,11 @@ def read_uff58(path, mapping=None, *, units=None) -> list[FRF]:
     """
     path = Path(path)
     if mapping is not None:
-        mapping = {int(k): int(v) for k, v in dict(mapping).items()}
+        try:
+            mapping = {int(k): int(v) for k, v in dict(mapping).items()}
+        except (TypeError, ValueError):
+            raise ModelError(f"read_uff58({path}): mapping must map UFF node numbers to model stations "
+                             f"(integers), e.g. {{101: 1}}; got {mapping!r}") from None
     units = {str(k).strip(): str(v) for k, v in dict(units or {}).items()}
     dsets = _read_sets(path)
     u164 = _units_164(dsets)

@@ -38,7 +38,7 @@ def _batch(args, prog) -> int:
     if args.json:
         import json
         print(json.dumps(rows, default=str))
-        return 0
+        return 1 if rows and all(r["status"] != "ok" for r in rows) else 0
     print(f"{'data set':<28} {'run':<7} {'diagnosis':<17} {'effects':<36} {'gain':>7} {'right':>6}")
     for r in rows:
         name = os.path.relpath(r["data_set"], args.batch)
@@ -51,7 +51,7 @@ def _batch(args, prog) -> int:
     print(f"{len(rows) - len(failed)} of {len(rows)} diagnosed" + (f", {len(failed)} failed" if failed else "")
           + (f"; right in {sum(bool(r['found']) for r in keyed)} of {len(keyed)} with an answer key" if keyed else ""))
     print(f"summary: {os.path.join(args.batch, 'summary.csv')}, {os.path.join(args.batch, 'index.html')}")
-    return 0
+    return 1 if rows and len(failed) == len(rows) else 0
 
 
 def run(args) -> int:
@@ -66,6 +66,9 @@ def run(args) -> int:
     if not args.model or not args.data:
         raise ModelError("give a model file and at least one measured FRF file (or --batch DIR)")
     # read_frfs: a Universal File may hold several FRFs (data sets 58), all used
+    if args.out is not None:
+        from .._files import output_directory
+        output_directory(args.out)        # checked before the work, not after it
     data = read_frfs(args.data)
     validate = read_frfs(args.validate) if args.validate else None
     res = diagnose(args.model, data, validate=validate, alpha=args.alpha, noise=args.noise,

@@ -4,6 +4,10 @@ from __future__ import annotations
 import json
 
 
+#: data sets one ``rig hide --count`` call may write (a class or a study; each is a few files)
+MAX_COUNT = 10_000
+
+
 def add_arguments(p):
     sub = p.add_subparsers(dest="action", required=True)
     h = sub.add_parser("hide", help="write a data set with a hidden effect (model, measured and validation "
@@ -25,8 +29,10 @@ def run(args) -> int:
     import os
     from ..errors import ModelError
     from ..hide import hidden_effect_data
-    if args.count < 1:
-        raise ModelError(f"--count must be at least 1, got {args.count}")
+    from .._files import output_directory
+    if args.count < 1 or args.count > MAX_COUNT:
+        raise ModelError(f"--count must be between 1 and {MAX_COUNT} (data sets of one call), got {args.count}")
+    output_directory(args.out)
     if args.count > 1:
         for seed in range(args.seed, args.seed + args.count):
             hidden_effect_data(args.example, seed=seed, kind=args.kind, noise=args.noise,

@@ -191,6 +191,9 @@ JSON_KEYS = ("mu", "mu_lower", "Wz", "K_order", "equivalent_stiffness_loss", "id
 
 
 def run(args) -> int:
+    if getattr(args, "plots", None) is not None:
+        from .._files import output_directory
+        output_directory(args.plots, "--plots")     # checked before the work, not after it
     from ..progress import ProgressLine
     prog = ProgressLine()        # the log and the W_z search's bar, both on stderr
     out = solve(args.depth, args.law, args.noise, args.seed, args.cutoff, args.thesis_tables, out=prog,

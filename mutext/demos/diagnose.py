@@ -32,6 +32,9 @@ def add_arguments(p):
 
 
 def run(args) -> int:
+    if getattr(args, "out", None) is not None:
+        from .._files import output_directory
+        output_directory(args.out, "--out")     # checked before the work, not after it
     from ..progress import ProgressLine
     from ..report import to_json, write_diagnosis
     out = args.out or tempfile.mkdtemp(prefix="mutext-diagnose-")

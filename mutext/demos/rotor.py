@@ -74,6 +74,9 @@ def solve(model_path=None, *, n_modes=6, points=400, band=(20.0, 225.0)):
 
 
 def run(args) -> int:
+    if getattr(args, "plots", None) is not None:
+        from .._files import output_directory
+        output_directory(args.plots, "--plots")     # checked before the work, not after it
     out = solve(args.model, n_modes=args.modes, points=args.points)
     if args.json:
         from ..jsonio import print_json

@@ -122,6 +122,9 @@ def figure(r, samples: int = 8):
 
 
 def run(args) -> int:
+    if getattr(args, "plots", None) is not None:
+        from .._files import output_directory
+        output_directory(args.plots, "--plots")     # checked before the work, not after it
     from ..progress import ProgressLine
     prog = None if args.quiet else ProgressLine()
     out = prog              # the search's log, below the progress bar (on stderr)

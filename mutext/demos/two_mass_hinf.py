@@ -53,6 +53,9 @@ def solve(params=two_mass.THESIS):
 
 
 def run(args) -> int:
+    if getattr(args, "plots", None) is not None:
+        from .._files import output_directory
+        output_directory(args.plots, "--plots")     # checked before the work, not after it
     params = two_mass.TwoMass() if args.exact_weights else two_mass.THESIS
     if not args.json:
         print("two-mass H-infinity problem (thesis sec. 2.3.1): "

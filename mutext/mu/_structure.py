@@ -98,8 +98,27 @@ class BlockStructure:
         """From a list like MATLAB's ``blk``: ``[r, c]`` full block, ``[-n, 0]``
         repeated real scalar, ``[n, 0]`` repeated complex scalar."""
         blocks = []
-        for item in spec:
-            r, c = (int(v) for v in item)
+        try:
+            items = list(spec)
+        except TypeError:
+            raise ModelError(f"block structure: expected a list of [rows, cols] pairs, got {spec!r}") from None
+        for k, item in enumerate(items):
+            try:
+                pair = list(item)
+            except TypeError:
+                raise ModelError(f"block structure, entry {k}: expected a pair [rows, cols], got {item!r}") \
+                    from None
+            if len(pair) != 2:
+                raise ModelError(f"block structure, entry {k}: expected a pair [rows, cols] ([r, c] full block, "
+                                 f"[-n, 0] repeated real scalar, [n, 0] repeated complex scalar), got {item!r}")
+            for v in pair:
+                ok = isinstance(v, (int, np.integer)) or (isinstance(v, (float, np.floating)) and float(v).is_integer())
+                if isinstance(v, bool) or not ok:
+                    raise ModelError(f"block structure, entry {k}: sizes must be integers, got {item!r}")
+            r, c = (int(v) for v in pair)
+            if r == 0 or c < 0 or (c > 0 and r < 0):
+                raise ModelError(f"block structure, entry {k}: {item!r} is not a block ([r, c] with r, c >= 1, "
+                                 "or [n, 0] / [-n, 0] with n >= 1)")
             if c == 0:
                 blocks.append(Block.real(-r) if r < 0 else Block.scalar(r))
             else:

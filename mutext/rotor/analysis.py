@@ -246,9 +246,17 @@ def _modes(model, speed, values, n, rigid_tol, matrices) -> Modes:
     for name, X in (("mass", M), ("damping", D), ("stiffness", K)):
         if not np.all(np.isfinite(X)):
             raise ModelError(f"{model.name}: the {name} matrix has non-finite entries (check the parameter values)")
-    Ks = 0.5 * (K + K.T)
+    Ks = 0.5 * K + 0.5 * K.T        # halves first: K + K.T overflows for stiffnesses near 1e308
+    overflow = (f"{model.name}: the natural frequencies overflow double precision (stiffness / mass ratios up to "
+                "about 1e308 rad^2/s^2 can be represented): check the units of the masses and stiffnesses")
     if not np.any(D):
-        lam, Phi = sla.eigh(Ks, M)
+        try:
+            with np.errstate(over="ignore", invalid="ignore"):
+                lam, Phi = sla.eigh(Ks, M)
+        except (ValueError, np.linalg.LinAlgError):
+            raise ModelError(overflow) from None
+        if not np.all(np.isfinite(lam)):
+            raise ModelError(overflow)
         scale = max(float(np.max(np.abs(lam))), 1e-300)
         if lam.min() < -rigid_tol**2 * scale:
             raise IllPosedError(_divergence(model, np.sqrt(-lam[lam < -rigid_tol**2 * scale])))
@@ -258,7 +266,13 @@ def _modes(model, speed, values, n, rigid_tol, matrices) -> Modes:
         shapes = Phi[:, keep].astype(complex)
         zeta = np.zeros_like(w)
     else:
-        ev, shapes = _damped_modes(M, D, K, Ks, rigid_tol, model)
+        try:
+            with np.errstate(over="ignore", invalid="ignore"):
+                ev, shapes = _damped_modes(M, D, K, Ks, rigid_tol, model)
+        except (ValueError, np.linalg.LinAlgError):
+            raise ModelError(overflow) from None
+        if not np.all(np.isfinite(ev)):
+            raise ModelError(overflow)
         w = ev.imag
         zeta = -ev.real / np.abs(ev)
     if n is not None:
