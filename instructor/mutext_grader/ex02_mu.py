@@ -34,6 +34,39 @@ of the largest singular value, no D-scaling, ``D M D`` instead of
 perturbation, ``I + M Delta`` instead of ``I - M Delta``, an LFT that closes
 with the wrong sign or lacks the size ``rel``, the channels in lower-LFT
 order.
+
+Inputs are drawn per run from the generator the grader passes
+(:func:`_draw`), each of the kind of the fixed cases before: the real
+rank-one ``2 x 2`` matrix of Skogestad & Postlethwaite's example 8.5 with
+its two vectors scaled by 0.7-1.3 (a full-rank variant of it for (a1)), the
+complex ``2 x 2`` and ``3 x 3`` matrices and the badly scaled real ``3 x 3``
+one with every entry scaled by 0.7-1.3 and turned by up to 0.4 rad (the
+real ones only scaled), the mass, stiffness and ``rel`` of (c) 30 % around
+the earlier values, the poles, gains and zeros of the two frequency
+responses of (d) 30 % around theirs.  A draw is kept only when every
+mistake named below gives a value at least 0.5 % (five tolerances) from
+the reference, and (b)'s mu is at least 10 % above what the trivial
+perturbations reach; so the usual mistakes never pass by chance.  Labels give a case's number and kind;
+feedback names the student's value and the mistake, never a reference value
+or a drawn number.
+
+What earns nothing (answers that do not solve the question):
+
+* (a1), (a2), (d): a value that is a named shortcut (the spectral radius,
+  the Frobenius norm, sigma_max without D-scaling, the real part only, the
+  bound at one frequency, ...) where it is wrong; and once a shortcut is
+  seen on one matrix, the matrices where it happens to be right (e.g. the
+  real part only, on a real matrix) earn nothing either;
+* (b): a perturbation that is not diagonal, does not make ``I - M Delta``
+  singular, or is no smaller than the ones found without a search: one
+  entry ``1/M_ii`` (``Delta = diag(1/M_11, 0, ...)``) or ``I / lambda``
+  with an eigenvalue of ``M``; half points need ``1/sigma_max(Delta)`` 2 %
+  above both, full points also 98 % of mutext's lower bound;
+* (c): a model with the wrong nominal part, or one too large (more than
+  :data:`MAX_STATES` states, never computed).
+
+Every size (the shape of (b)'s array, the states and channels of (c)'s
+model) is checked in the check function before anything is computed.
 """
 from __future__ import annotations
 
@@ -49,22 +82,26 @@ from .core import Call, Exercise, Question
 POINTS = {"a1": 1.0, "a2": 2.0, "b": 2.0, "c": 3.0, "d": 2.0}
 RTOL_MU = 1e-3          # (a), (d): relative tolerance on mu
 LOWER_FRACTION = 0.98   # (b): 1/sigma_max(Delta) must reach this fraction of the reference lower bound
+TRIVIAL_MARGIN = 1.02   # (b): ... and exceed the trivial perturbations' 1/sigma_max by this factor
 SINGULAR_TOL = 1e-6     # (b): |det(I - M Delta)| / prod(1 + sigma_i(M Delta))
 RTOL_LFT = 1e-6         # (c): closed-loop frequency responses
 DELTAS = (-1.0, -0.4, 0.0, 0.6, 1.0)
+DISTINCT = 5e-3         # a draw is kept when every named mistake is 5 tolerances (relative) from the reference
+TRIVIAL_GAP = 1.10      # (b): mu is at least this factor above the trivial Delta's 1/sigma_max
+MAX_STATES = 6          # (c): three times the two states of the mass-spring model
 
-#: test matrices of (a) and (b): label -> M
-MATRICES = {
-    "M = [[2, 2], [-1, -1]] (Skogestad & Postlethwaite, example 8.5)": np.array([[2.0, 2.0], [-1.0, -1.0]]),
-    "complex 2x2 M": np.array([[1.0 + 1.0j, 4.0 - 2.0j], [0.2 + 0.1j, 1.5 - 1.0j]]),
-    "complex 3x3 M": np.array([[0.3 - 1.2j, 2.0 + 0.5j, -0.4 + 0.0j],
-                               [0.1 + 0.2j, -0.7 + 0.9j, 3.0 - 1.0j],
-                               [1.5 + 0.0j, 0.05 - 0.3j, 0.6 + 0.4j]]),
-    "badly scaled real 3x3 M": np.array([[1.0, 20.0, 0.0], [0.05, 1.0, 10.0], [0.5, 0.1, -2.0]]),
+#: the fixed cases the draws perturb: label -> M
+BASE = {
+    "real 2x2": np.array([[2.0, 2.0], [-1.0, 1.0]]),     # (a1): example 8.5 with a full rank
+    "complex 2x2": np.array([[1.0 + 1.0j, 4.0 - 2.0j], [0.2 + 0.1j, 1.5 - 1.0j]]),
+    "complex 3x3": np.array([[0.3 - 1.2j, 2.0 + 0.5j, -0.4 + 0.0j],
+                             [0.1 + 0.2j, -0.7 + 0.9j, 3.0 - 1.0j],
+                             [1.5 + 0.0j, 0.05 - 0.3j, 0.6 + 0.4j]]),
+    "badly scaled real 3x3": np.array([[1.0, 20.0, 0.0], [0.05, 1.0, 10.0], [0.5, 0.1, -2.0]]),
 }
-B_LABELS = list(MATRICES)[:3]
+SP_LABEL = "real rank-one 2x2 (as Skogestad & Postlethwaite, example 8.5)"
 
-#: (c): (m [kg], k [N/m], rel)
+#: (c): (m [kg], k [N/m], rel) the draws perturb
 SPRINGS = [(2.0, 800.0, 0.2), (0.5, 3.0e4, 0.35)]
 
 
@@ -82,10 +119,15 @@ def _structure(n):
     return BlockStructure.from_spec([[1, 0]] * n)
 
 
-_LOCK = threading.Lock()
+_LOCK = threading.RLock()
 
 
-@functools.lru_cache(maxsize=256)
+def _key(M):
+    M = np.asarray(M, dtype=complex)
+    return (M.shape, tuple(M.ravel().tolist()))
+
+
+@functools.lru_cache(maxsize=2048)
 def _upper_cached(key):
     from mutext.mu import mu_upper
     M = np.array(key[1]).reshape(key[0])
@@ -94,12 +136,11 @@ def _upper_cached(key):
 
 def mu_upper_ref(M):
     """D-scaling upper bound (``n`` complex ``1 x 1`` blocks) from :func:`mutext.mu.mu_upper`."""
-    M = np.asarray(M, dtype=complex)
     with _LOCK:
-        return _upper_cached((M.shape, tuple(M.ravel().tolist())))
+        return _upper_cached(_key(M))
 
 
-@functools.lru_cache(maxsize=16)
+@functools.lru_cache(maxsize=256)
 def _lower_cached(key):
     from mutext.mu import mu_bounds
     M = np.array(key[1]).reshape(key[0])
@@ -108,39 +149,142 @@ def _lower_cached(key):
 
 def mu_lower_ref(M):
     """Lower bound (``n`` complex ``1 x 1`` blocks) from :func:`mutext.mu.mu_bounds`."""
-    M = np.asarray(M, dtype=complex)
     with _LOCK:
-        return _lower_cached((M.shape, tuple(M.ravel().tolist())))
+        return _lower_cached(_key(M))
 
 
 SWEEP_W = np.logspace(-1, 1.5, 40)     # rad/s
 
 
-def sweep(which):
-    """Frequency response ``(N, n, n)`` of the test systems of (d)."""
+def _sweep2(p):
+    """The 2x2 response of (d): ``[[g1/(s+a1), g2 s/den], [-g3/(s+a2), (s+a3)/den]]``, ``den = s^2 + c s + w0^2``."""
     s = 1j * SWEEP_W
+    den = s**2 + p["c"] * s + p["w0"] ** 2
+    return np.stack([np.array([[p["g1"] / (si + p["a1"]), p["g2"] * si / di],
+                               [-p["g3"] / (si + p["a2"]), (si + p["a3"]) / di]]) for si, di in zip(s, den)])
+
+
+def _sweep3(p):
+    """The 3x3 response of (d): a lightly damped pair and a real pole, ``C (sI - A)^-1 B``."""
+    s = 1j * SWEEP_W
+    A = np.array([[-p["sigma"], p["omega"], 0.0], [-p["omega"], -p["sigma"], 0.0], [0.0, 0.0, -p["pole"]]])
+    return np.stack([p["C"] @ np.linalg.solve(si * np.eye(3) - A, p["B"]) for si in s])
+
+
+def sweep(which, rng=None):
+    """Frequency response ``(N, n, n)`` of test system ``which`` of (d): the fixed one without ``rng``,
+    else drawn 30 % around it."""
+    f = (lambda x: x) if rng is None else (lambda x: x * rng.uniform(0.7, 1.3, np.shape(x)))
     if which == 0:
-        den = s**2 + 0.3 * s + 4.0
-        return np.stack([np.array([[2.0 / (si + 1.0), 3.0 * si / di], [-0.5 / (si + 0.5), (si + 1.0) / di]])
-                         for si, di in zip(s, den)])
-    A = np.array([[-0.2, 3.0, 0.0], [-3.0, -0.2, 0.0], [0.0, 0.0, -1.5]])
+        return _sweep2({k: float(f(v)) for k, v in
+                        dict(g1=2.0, a1=1.0, g2=3.0, g3=0.5, a2=0.5, a3=1.0, c=0.3, w0=2.0).items()})
     B = np.array([[1.0, 0.0, 0.5], [0.0, 2.0, 0.0], [0.3, 0.0, 1.0]])
     C = np.array([[0.0, 1.0, 0.2], [1.0, 0.0, 0.0], [0.1, 0.5, 2.0]])
-    return np.stack([C @ np.linalg.solve(si * np.eye(3) - A, B) for si in s])
+    return _sweep3(dict(sigma=float(f(0.2)), omega=float(f(3.0)), pole=float(f(1.5)), B=f(B), C=f(C)))
 
 
-def peak_ref(which):
-    return max(mu_upper_ref(M) for M in sweep(which))
+def peak_ref(Ms):
+    """The peak over frequency of the upper bound of a response ``(N, n, n)``."""
+    return max(mu_upper_ref(M) for M in Ms)
+
+
+# ----------------------------------------------------------------------------
+# inputs drawn per run
+# ----------------------------------------------------------------------------
+
+def _perturb(rng, M):
+    """Every entry scaled by 0.7-1.3 and, for a complex ``M``, turned by up to 0.4 rad."""
+    f = rng.uniform(0.7, 1.3, M.shape)
+    if np.iscomplexobj(M):
+        return M * f * np.exp(1j * rng.uniform(-0.4, 0.4, M.shape))
+    return M * f
+
+
+def _sp_rank_one(rng):
+    u = np.array([2.0, -1.0]) * rng.uniform(0.7, 1.3, 2)
+    v = np.array([1.0, 1.0]) * rng.uniform(0.7, 1.3, 2)
+    return np.outer(u, v)
+
+
+def _apart(ref, values):
+    return all(not np.isfinite(v) or abs(v - ref) > DISTINCT * abs(ref) for v in values)
+
+
+def _trivial_delta(M):
+    """``1/sigma_max`` of the best perturbation found without a search: one entry ``1/M_ii``, or ``I/lambda``."""
+    return max(float(np.abs(np.diag(M)).max()), float(np.abs(np.linalg.eigvals(M)).max()))
+
+
+def _ok_full(M):
+    ref = float(_sv(M)[0])
+    vals = [v for v, name, _ in _mistakes_full(M) if not (name == "the real part only" and not M.imag.any())]
+    return _apart(ref, vals)
+
+
+def _ok_scalar(M, with_lower):
+    ref = mu_upper_ref(M)
+    vals = [v for v, name, _ in _mistakes_scalar(M) if not (name == "the real part only" and not M.imag.any())]
+    if not _apart(ref, vals):
+        return False
+    # mu is the bound here (at most three complex scalar blocks); the lower bound is computed in ``prepare``
+    return not with_lower or ref >= TRIVIAL_GAP * _trivial_delta(M)
+
+
+def _ok_sweep(Ms):
+    """Every named mistake of (d) is apart from the peak, decided from singular values and spectral radii
+    and the bound at the few frequencies that matter (the whole peak is computed later, in ``prepare``):
+    ``rho(M) <= bound <= sigma_max(M)`` at every frequency."""
+    sig = np.array([_sv(M)[0] for M in Ms])
+    rho = np.array([max(abs(np.linalg.eigvals(M))) for M in Ms])
+    low = (1.0 - DISTINCT) * rho.max()          # the peak is at least rho.max()
+    # the bound at one frequency, the minimum and the mean are at most the corresponding sigma's
+    if max(sig[0], sig[-1], sig.min(), sig.mean()) >= low:
+        return False
+    # the peak against the peak of rho: the bound where rho peaks is a lower bound of the peak
+    if mu_upper_ref(Ms[int(np.argmax(rho))]) <= (1.0 + DISTINCT) * rho.max():
+        return False
+    # the peak against the peak of sigma: only frequencies with sigma near its peak can bring it near
+    near = np.flatnonzero(sig >= (1.0 - DISTINCT) * sig.max())
+    return all(mu_upper_ref(Ms[k]) < (1.0 - DISTINCT) * sig.max() for k in near)
+
+
+def _until(rng, make, ok, tries=200):
+    """The first of ``make()``'s draws that passes ``ok`` (the last one tried if none does)."""
+    for _ in range(tries):
+        x = make()
+        if ok(x):
+            return x
+    return x
+
+
+def _draw(rng):
+    """Every graded input of one run, drawn from ``rng`` (``questions`` and ``prepare`` both call this)."""
+    sp = _until(rng, lambda: _sp_rank_one(rng).astype(complex), lambda M: _ok_scalar(M, True))
+    sp_full = _until(rng, lambda: _perturb(rng, BASE["real 2x2"]).astype(complex), _ok_full)
+    c2 = _until(rng, lambda: _perturb(rng, BASE["complex 2x2"]),
+                lambda M: _ok_full(M) and _ok_scalar(M, True))
+    c3 = _until(rng, lambda: _perturb(rng, BASE["complex 3x3"]),
+                lambda M: _ok_full(M) and _ok_scalar(M, True))
+    bs = _until(rng, lambda: _perturb(rng, BASE["badly scaled real 3x3"]).astype(complex),
+                lambda M: _ok_full(M) and _ok_scalar(M, False))
+    a1 = [("real 2x2", sp_full), ("complex 2x2", c2), ("complex 3x3", c3), ("badly scaled real 3x3", bs)]
+    a2 = [(SP_LABEL, sp), ("complex 2x2", c2), ("complex 3x3", c3), ("badly scaled real 3x3", bs)]
+    springs = [tuple(float(x * rng.uniform(0.7, 1.3)) for x in base) for base in SPRINGS]
+    d = [("2x2 response", _until(rng, lambda: sweep(0, rng), _ok_sweep)),
+         ("3x3 response", _until(rng, lambda: sweep(1, rng), _ok_sweep))]
+    return {"a1": a1, "a2": a2, "b": a2[:3], "c": springs, "d": d}
 
 
 def prepare(rng=None):
-    """Reference bounds of all calls, while the child runs."""
-    for M in MATRICES.values():
-        mu_upper_ref(M)
-    for lab in B_LABELS:
-        mu_lower_ref(MATRICES[lab])
-    for i in (0, 1):
-        peak_ref(i)
+    """Reference bounds of all calls (the same draws as :func:`questions` with an equal generator)."""
+    if rng is not None:
+        draw = _draw(rng)
+        for _, M in draw["a2"]:
+            mu_upper_ref(M)
+        for _, M in draw["b"]:
+            mu_lower_ref(M)
+        for _, Ms in draw["d"]:
+            peak_ref(Ms)
 
 
 # ----------------------------------------------------------------------------
@@ -156,9 +300,9 @@ def _sv(M):
     return np.linalg.svd(M, compute_uv=False)
 
 
-def dmd_value(M):
-    """``min sigma_max(D M D)`` with the last entry of ``D`` fixed to 1 (the mistake ``D M D``)."""
-    M = np.asarray(M, dtype=complex)
+@functools.lru_cache(maxsize=256)
+def _dmd_cached(key):
+    M = np.array(key[1]).reshape(key[0])
     n = M.shape[0]
 
     def f(x):
@@ -170,16 +314,22 @@ def dmd_value(M):
     return float(np.exp(r.fun))
 
 
+def dmd_value(M):
+    """``min sigma_max(D M D)`` with the last entry of ``D`` fixed to 1 (the mistake ``D M D``)."""
+    with _LOCK:
+        return _dmd_cached(_key(M))
+
+
 def _mistakes_scalar(M):
-    """``(value, text)`` of the usual wrong answers for ``n`` complex scalar blocks."""
+    """``(value, name, text)`` of the usual wrong answers for ``n`` complex scalar blocks."""
     sv = _sv(M)
     return [
-        (sv[0], "no D-scaling: this is sigma_max(M), mu for one full block; minimise sigma_max(D M D^-1) "
-                "over positive diagonal D"),
-        (max(abs(np.linalg.eigvals(M))), "returned the spectral radius max|eig(M)|, a lower bound on mu "
-                                         "(not the D-scaling upper bound)"),
-        (dmd_value(M), "D applied as D M D instead of D M D^-1 (the scaling must be a similarity)"),
-        (mu_upper_ref(M.real) if M.shape[0] > 0 else np.nan,
+        (sv[0], "sigma_max(M)", "no D-scaling: this is sigma_max(M), mu for one full block; minimise "
+                                "sigma_max(D M D^-1) over positive diagonal D"),
+        (max(abs(np.linalg.eigvals(M))), "the spectral radius",
+         "returned the spectral radius max|eig(M)|, a lower bound on mu (not the D-scaling upper bound)"),
+        (dmd_value(M), "D M D", "D applied as D M D instead of D M D^-1 (the scaling must be a similarity)"),
+        (mu_upper_ref(M.real) if M.shape[0] > 0 else np.nan, "the real part only",
          "this is the bound of the real part of M only: build M = M_re + 1j*M_im"),
     ]
 
@@ -187,25 +337,61 @@ def _mistakes_scalar(M):
 def _mistakes_full(M):
     sv = _sv(M)
     return [
-        (max(abs(np.linalg.eigvals(M))), "returned the spectral radius max|eig(M)|, not the largest singular "
-                                         "value (the spectral radius is mu of a repeated scalar block delta I)"),
-        (np.linalg.norm(M, "fro"), "returned the Frobenius norm, not the largest singular value"),
-        (sv[-1], "returned the smallest singular value, not the largest"),
-        (sv[0] ** 2, "returned sigma_max^2 (the largest eigenvalue of M^H M): take the square root"),
-        (_sv(M.real)[0], "this is sigma_max of the real part of M only: build M = M_re + 1j*M_im"),
+        (max(abs(np.linalg.eigvals(M))), "the spectral radius",
+         "returned the spectral radius max|eig(M)|, not the largest singular value (the spectral radius is "
+         "mu of a repeated scalar block delta I)"),
+        (np.linalg.norm(M, "fro"), "the Frobenius norm", "returned the Frobenius norm, not the largest singular value"),
+        (sv[-1], "the smallest singular value", "returned the smallest singular value, not the largest"),
+        (sv[0] ** 2, "sigma_max^2", "returned sigma_max^2 (the largest eigenvalue of M^H M): take the square root"),
+        (_sv(M.real)[0], "the real part only",
+         "this is sigma_max of the real part of M only: build M = M_re + 1j*M_im"),
     ]
 
 
+def _band(x, ref):
+    """How far ``x`` is from ``ref``, in words that do not give ``ref`` away."""
+    r = abs(x / ref - 1.0) if ref else np.inf
+    side = "too high" if x > ref else "too low"
+    if r < 1e-2:
+        return f"{side} by less than 1 %"
+    if r < 0.1:
+        return f"{side} by 1-10 %"
+    return f"{side} by more than 10 %"
+
+
 def _diagnose(x, ref, mistakes, sigma=None):
-    texts = [text for val, text in mistakes if _close(x, val) and not _close(val, ref)]
+    texts = [text for val, _, text in mistakes if _close(x, val) and not _close(val, ref)]
     if texts:
         return "; or ".join(texts)      # e.g. rho(M) and min sigma(D M D) coincide for a rank-one M
     if not np.isfinite(x):
         return "the value is not finite"
     if sigma is not None and ref < x < sigma:
-        return (f"expected {fmt(ref)}, got {fmt(x)}: between the optimum and sigma_max(M), so the minimisation over "
-                "D did not converge (tighten the tolerance, or bisect on the LMI M^H X M - beta^2 X <= 0)")
-    return f"expected {fmt(ref)}, got {fmt(x)}"
+        return (f"your value {fmt(x)} lies between the optimum and sigma_max(M), so the minimisation over D did "
+                "not converge (tighten the tolerance, or bisect on the LMI M^H X M - beta^2 X <= 0)")
+    return f"your value {fmt(x)} is {_band(x, ref)}"
+
+
+def _caught(x, ref, mistakes):
+    """Names of the mistakes ``x`` is (where they are wrong)."""
+    return {name for val, name, _ in mistakes if _close(x, val) and not _close(val, ref)}
+
+
+def _easy(ref, mistakes):
+    """Names of the mistakes that happen to give ``ref``."""
+    return {name for val, name, _ in mistakes if _close(val, ref)}
+
+
+def _score_right(fb, right, easy, caught, labels, per):
+    """Points of the right calls; none where a shortcut seen elsewhere happens to be right."""
+    score, n_ok = 0.0, 0
+    for ok, e, label in zip(right, easy, labels):
+        if ok and e & caught:
+            fb.append(f"[{label}] 0 points: the shortcut seen on another case ({sorted(e & caught)[0]}) happens to "
+                      "give this case's value")
+        elif ok:
+            score += per
+            n_ok += 1
+    return score, n_ok
 
 
 def _correct(fb, n_ok, n, text):
@@ -218,23 +404,28 @@ def _correct(fb, n_ok, n, text):
 # (a) mu of one full block and the D-scaling upper bound
 # ----------------------------------------------------------------------------
 
-def _check_a(outcomes, calls, which):
+def _check_a(outcomes, calls, which, matrices):
     qid = "a1" if which == "full" else "a2"
     per = POINTS[qid] / len(calls)
-    score, fb, n_ok = 0.0, [], 0
-    for call, tag, value in returned(outcomes, calls, fb):
-        x = float(value)
-        M = MATRICES[call.label]
+    fb, right, easy, caught = [], [], [], set()
+    for call, oc, (_, M) in zip(calls, outcomes, matrices):
         if which == "full":
             ref, mistakes = float(_sv(M)[0]), _mistakes_full(M)
         else:
             ref, mistakes = mu_upper_ref(M), _mistakes_scalar(M)
-        if _close(x, ref):
-            score += per
-            n_ok += 1
+        easy.append(_easy(ref, mistakes))
+        if not oc["ok"]:
+            fb.append(f"[{call.label}] {oc['error']}")
+            right.append(False)
             continue
+        x = float(oc["value"])
+        right.append(_close(x, ref))
+        if right[-1]:
+            continue
+        caught |= _caught(x, ref, mistakes)
         sigma = None if which == "full" else float(_sv(M)[0])
-        fb.append(f"{tag} {_diagnose(x, ref, mistakes, sigma)}")
+        fb.append(f"[{call.label}] {_diagnose(x, ref, mistakes, sigma)}")
+    score, n_ok = _score_right(fb, right, easy, caught, [c.label for c in calls], per)
     what = "sigma_max(M) of every matrix" if which == "full" else "the D-scaling bound of every matrix"
     return score, _correct(fb, n_ok, len(calls), what)
 
@@ -249,18 +440,26 @@ def _residual(M, Delta):
     return float(abs(np.linalg.det(np.eye(M.shape[0]) - MD)) / np.prod(1.0 + _sv(MD)))
 
 
-def _check_b(outcomes, calls):
+def _check_b(outcomes, calls, matrices):
     per = POINTS["b"] / len(calls)
     score, fb, n_ok = 0.0, [], 0
-    for call, tag, X in returned(outcomes, calls, fb, as_array, "destabilizing_delta()"):
-        M = MATRICES[call.label]
+    for call, oc, (_, M) in zip(calls, outcomes, matrices):
+        tag = f"[{call.label}]"
+        if not oc["ok"]:
+            fb.append(f"{tag} {oc['error']}")
+            continue
         n = M.shape[0]
+        shape = oc["value"].get("shape") if isinstance(oc["value"], dict) else None
+        if shape not in ([2, n, n], [2, n]):        # checked before the data are read
+            fb.append(f"{tag} return the pair (Delta.real, Delta.imag) of the {n}x{n} diagonal Delta "
+                      f"(an array of shape (2, {n}, {n})), got shape {tuple(shape) if isinstance(shape, list) else shape}")
+            continue
+        X, err = as_array(oc["value"], "destabilizing_delta()")
+        if err:
+            fb.append(f"{tag} {err}")
+            continue
         if X.shape == (2, n):
             X = np.stack([np.diag(X[0]), np.diag(X[1])])
-        if X.shape != (2, n, n):
-            fb.append(f"{tag} return the pair (Delta.real, Delta.imag) of the {n}x{n} diagonal Delta "
-                      f"(an array of shape (2, {n}, {n})), got shape {X.shape}")
-            continue
         Delta = X[0] + 1j * X[1]
         if not np.all(np.isfinite(Delta)):
             fb.append(f"{tag} Delta has entries that are not finite")
@@ -291,15 +490,19 @@ def _check_b(outcomes, calls):
             fb.append(f"{tag} {msg}")
             continue
         mu_d = 1.0 / float(_sv(Delta)[0])
-        lower = mu_lower_ref(M)
-        if mu_d >= LOWER_FRACTION * lower:
+        if mu_d <= TRIVIAL_MARGIN * _trivial_delta(M):
+            fb.append(f"{tag} 0 points: Delta destabilises (1/sigma_max(Delta) = {fmt(mu_d)}), but it is no smaller "
+                      "than a perturbation found without any search (one entry 1/M_ii, as diag(1/M_11, 0, ...), "
+                      "or I / lambda with an eigenvalue lambda of M): maximise rho(M U) over diagonal unitary U")
+            continue
+        if mu_d >= LOWER_FRACTION * mu_lower_ref(M):
             score += per
             n_ok += 1
             continue
         score += per / 2
-        fb.append(f"{tag} half points: Delta destabilises, but 1/sigma_max(Delta) = {fmt(mu_d)} while a diagonal "
-                  f"Delta with 1/sigma_max = {fmt(lower)} exists (mu >= {fmt(lower)}): maximise rho(M U) over "
-                  "diagonal unitary U")
+        fb.append(f"{tag} half points: Delta destabilises and 1/sigma_max(Delta) = {fmt(mu_d)} beats the trivial "
+                  f"perturbations, but a diagonal Delta more than {100 * (1 - LOWER_FRACTION):g} % smaller exists: "
+                  "maximise rho(M U) over diagonal unitary U")
     return score, _correct(fb, n_ok, len(calls), "every Delta is diagonal, makes I - M Delta singular and is "
                                                  "as small as mutext's lower bound")
 
@@ -374,8 +577,16 @@ def _diagnose_lft(Ps, s, m, k, rel):
         return ("the LFT closes with the wrong sign: w = delta z gives k (1 - rel delta); with z = rel k x the "
                 "force -w (not +w) acts on the mass")
     if abs(c - 1.0) <= 1e-6:
-        return f"the size rel is missing: your k varies as k (1 + delta), expected k (1 + {rel:g} delta)"
-    return f"closing w = delta z gives k (1 + {c:.4g} delta), expected k (1 + {rel:g} delta)"
+        return "the size rel is missing: your k varies as k (1 + delta), expected k (1 + rel delta)"
+    return f"closing w = delta z gives k (1 + {c:.4g} delta), expected k (1 + rel delta)"
+
+
+def _raw_dims(value):
+    """Upper bounds of (states, inputs, outputs) read off the returned lists, before any matrix is built."""
+    A, B, C, D = (value.get(k) or [] for k in "ABCD")
+    n = max(len(A), max((len(r) for r in A), default=0), len(B), max((len(r) for r in C), default=0))
+    m = max(max((len(r) for r in B), default=0), max((len(r) for r in D), default=0))
+    return n, m, max(len(C), len(D))
 
 
 def _check_c(outcomes, calls):
@@ -383,6 +594,15 @@ def _check_c(outcomes, calls):
     score, fb, n_ok = 0.0, [], 0
     for call, tag, value in returned(outcomes, calls, fb):
         v = value
+        n, n_in, n_out = _raw_dims(v)
+        if n > MAX_STATES:
+            fb.append(f"{tag} the model has {n} states; at most {MAX_STATES} are accepted (three times the 2 of "
+                      "the mass-spring model): not evaluated, 0 points")
+            continue
+        if n_in > 2 or n_out > 2:
+            fb.append(f"{tag} P must have 2 inputs [w, f] and 2 outputs [z, x], got {n_in} inputs and "
+                      f"{n_out} outputs")
+            continue
         try:
             A, B, C, D = (np.atleast_2d(np.asarray(v[x], dtype=float)) for x in "ABCD")
         except Exception as exc:   # noqa: BLE001
@@ -419,36 +639,46 @@ def _check_c(outcomes, calls):
 # (d) peak over frequency
 # ----------------------------------------------------------------------------
 
-def _check_d(outcomes, calls):
+def _mistakes_peak(Ms):
+    """``(value, name, text)`` of the usual wrong answers for the peak over frequency."""
+    bounds = [mu_upper_ref(M) for M in Ms]
+    return [
+        (max(_sv(M)[0] for M in Ms), "sigma_max(M(jw))", "no D-scaling: this is the peak of sigma_max(M(jw)); take "
+                                                         "the peak of min_D sigma_max(D M D^-1) of (a)"),
+        (max(max(abs(np.linalg.eigvals(M))) for M in Ms), "the spectral radius",
+         "this is the peak of the spectral radius, a lower bound, not of the D-scaling upper bound"),
+        (bounds[-1], "the last frequency", "this is the bound at the last frequency, not the peak over all "
+                                           "frequencies"),
+        (bounds[0], "the first frequency", "this is the bound at the first frequency, not the peak over all "
+                                           "frequencies"),
+        (min(bounds), "the minimum", "this is the minimum over frequency; the peak is the maximum"),
+        (float(np.mean(bounds)), "the mean", "this is the mean over frequency; the peak is the maximum"),
+    ]
+
+
+def _check_d(outcomes, calls, sweeps):
     per = POINTS["d"] / len(calls)
-    score, fb, n_ok = 0.0, [], 0
-    for i, (call, oc) in enumerate(zip(calls, outcomes)):
+    fb, right, easy, caught = [], [], [], set()
+    for call, oc, (_, Ms) in zip(calls, outcomes, sweeps):
         tag = f"[{call.label}]"
+        ref = peak_ref(Ms)
+        mistakes = _mistakes_peak(Ms)
+        easy.append(_easy(ref, mistakes))
         if not oc["ok"]:
             fb.append(f"{tag} {oc['error']}")
+            right.append(False)
             continue
         x = float(oc["value"])
-        Ms = sweep(i)
-        ref = peak_ref(i)
-        if _close(x, ref):
-            score += per
-            n_ok += 1
+        right.append(_close(x, ref))
+        if right[-1]:
             continue
-        mistakes = [
-            (max(_sv(M)[0] for M in Ms), "no D-scaling: this is the peak of sigma_max(M(jw)); take the peak of "
-                                         "min_D sigma_max(D M D^-1) of (a)"),
-            (max(max(abs(np.linalg.eigvals(M))) for M in Ms), "this is the peak of the spectral radius, a lower "
-                                                               "bound, not of the D-scaling upper bound"),
-            (mu_upper_ref(Ms[-1]), "this is the bound at the last frequency, not the peak over all frequencies"),
-            (mu_upper_ref(Ms[0]), "this is the bound at the first frequency, not the peak over all frequencies"),
-            (min(mu_upper_ref(M) for M in Ms), "this is the minimum over frequency; the peak is the maximum"),
-        ]
-        msg = next((t for val, t in mistakes if _close(x, val) and not _close(val, ref)), None)
+        caught |= _caught(x, ref, mistakes)
+        msg = next((t for val, _, t in mistakes if _close(x, val) and not _close(val, ref)), None)
         if msg is None and np.isfinite(x) and x < ref:
-            at = int(np.argmax([mu_upper_ref(M) for M in Ms]))
-            msg = (f"expected {fmt(ref)}, got {fmt(x)}: the bound reaches {fmt(ref)} at w = {fmt(SWEEP_W[at])} "
-                   f"rad/s (entry {at}); take the largest bound over all {len(Ms)} frequencies")
-        fb.append(f"{tag} {msg or f'expected {fmt(ref)}, got {fmt(x)}'}")
+            msg = (f"your value {fmt(x)} is {_band(x, ref)}: the bound is larger at some frequency; take the "
+                   f"largest bound over all {len(Ms)} frequencies")
+        fb.append(f"{tag} {msg or _diagnose(x, ref, [])}")
+    score, n_ok = _score_right(fb, right, easy, caught, [c.label for c in calls], per)
     return score, _correct(fb, n_ok, len(calls), "the peak of the upper bound of both frequency responses")
 
 
@@ -457,23 +687,25 @@ def _check_d(outcomes, calls):
 # ----------------------------------------------------------------------------
 
 def questions(rng=None):
-    """The five questions with their test inputs."""
-    a_calls = [Call(lab, _split(M)) for lab, M in MATRICES.items()]
-    b_calls = [Call(lab, _split(MATRICES[lab])) for lab in B_LABELS]
-    c_calls = [Call(f"m = {m:g} kg, k = {k:g} N/m, rel = {rel:g}", [m, k, rel]) for m, k, rel in SPRINGS]
-    d_calls = [Call("2x2 response, 40 frequencies", _split(sweep(0))),
-               Call("3x3 response, 40 frequencies", _split(sweep(1)))]
+    """The five questions with their inputs drawn from ``rng`` (a fresh generator without one)."""
+    draw = _draw(rng if rng is not None else np.random.default_rng())
+
+    def calls(cases):
+        return [Call(f"matrix {i + 1} of {len(cases)}: {lab}", _split(M)) for i, (lab, M) in enumerate(cases)]
+    a1_calls, a2_calls, b_calls = calls(draw["a1"]), calls(draw["a2"]), calls(draw["b"])
+    c_calls = [Call(f"parameter set {i + 1} of {len(draw['c'])}", list(p)) for i, p in enumerate(draw["c"])]
+    d_calls = [Call(f"{lab}, {len(Ms)} frequencies", _split(Ms)) for lab, Ms in draw["d"]]
     return [
-        Question("a1", "mu_full", "mu for one full complex block", POINTS["a1"], "float", a_calls,
-                 lambda oc: _check_a(oc, a_calls, "full")),
+        Question("a1", "mu_full", "mu for one full complex block", POINTS["a1"], "float", a1_calls,
+                 lambda oc: _check_a(oc, a1_calls, "full", draw["a1"])),
         Question("a2", "mu_scalar_blocks_upper", "D-scaling upper bound for scalar blocks", POINTS["a2"], "float",
-                 a_calls, lambda oc: _check_a(oc, a_calls, "scalar")),
+                 a2_calls, lambda oc: _check_a(oc, a2_calls, "scalar", draw["a2"])),
         Question("b", "destabilizing_delta", "smallest destabilising diagonal Delta", POINTS["b"], "array",
-                 b_calls, lambda oc: _check_b(oc, b_calls)),
+                 b_calls, lambda oc: _check_b(oc, b_calls, draw["b"])),
         Question("c", "uncertain_spring_lft", "uncertain spring as an upper LFT", POINTS["c"], "ss", c_calls,
                  lambda oc: _check_c(oc, c_calls)),
         Question("d", "mu_peak", "peak of the upper bound over frequency", POINTS["d"], "float", d_calls,
-                 lambda oc: _check_d(oc, d_calls)),
+                 lambda oc: _check_d(oc, d_calls, draw["d"])),
     ]
 
 
