@@ -6,9 +6,11 @@ confinement).  It imports only the standard library, reads the request and
 the runner's source, then, in this order:
 
 1. as root, in a new mount (and network and IPC) namespace: covers the
-   grader's package, the source checkout, ``/root``, ``/home`` and the
-   temporary directories with empty read-only file systems, keeping only the
-   Python installation and the child's own directories visible;
+   grader's package, the source checkout, ``/root``, ``/home``, the
+   temporary directories and the submission's own directory (its batch-mates)
+   with empty read-only file systems, keeping only the Python installation
+   and the child's own directories visible; a small tmpfs (bytes and files
+   limited) over the scratch directory;
 2. as root, drops to an unprivileged user (``nobody``, no supplementary
    groups) that owns nothing but the child's scratch directory;
 3. sets ``no_new_privs`` and a Landlock ruleset (reading only the Python
@@ -16,7 +18,9 @@ the runner's source, then, in this order:
    only its scratch directory; no TCP; no signals to processes outside);
 4. a seccomp filter: no new processes (``fork``, ``vfork``, ``clone`` other
    than threads), no ``execve``, no ``ptrace``, mount or namespace changes,
-   no sockets (a user's D-Bus could start programs outside), no keyrings;
+   no sockets (a user's D-Bus could start programs outside), no keyrings, no
+   memory outside the address-space limit (``memfd_create``, System V shared
+   memory and message queues);
 5. resource limits (address space, CPU time, file size, processes, core dumps).
 
 All of these are kernel state that the Python code running afterwards can
@@ -64,20 +68,26 @@ LL_NET_BIND_TCP, LL_NET_CONNECT_TCP = 1 << 0, 1 << 1
 LL_SCOPE_ABSTRACT_UNIX_SOCKET, LL_SCOPE_SIGNAL = 1 << 0, 1 << 1
 O_PATH = getattr(os, "O_PATH", 0o10000000)
 
-#: seccomp: audit architecture and the system calls denied to the submission
+#: seccomp: audit architecture and the system calls denied to the submission (EPERM; the process goes on).
+#: Besides new processes, privileges and namespaces: memory the address-space limit does not count
+#: (``memfd_create``, ``memfd_secret``, System V shared memory and message queues) and ``socketpair``
+#: (socket buffers, and descriptors in flight that no listing of the process shows)
 SECCOMP_ARCH = {
     "x86_64": (0xC000003E, {"fork": 57, "vfork": 58, "clone": 56, "clone3": 435, "execve": 59, "execveat": 322,
                             "ptrace": 101, "process_vm_readv": 310, "process_vm_writev": 311, "unshare": 272,
                             "setns": 308, "mount": 165, "umount2": 166, "pivot_root": 155, "chroot": 161,
                             "bpf": 321, "perf_event_open": 298, "io_uring_setup": 425, "userfaultfd": 323,
                             "kexec_load": 246, "init_module": 175, "finit_module": 313, "socket": 41,
-                            "keyctl": 250, "add_key": 248, "request_key": 249}),
+                            "keyctl": 250, "add_key": 248, "request_key": 249, "socketpair": 53,
+                            "memfd_create": 319, "memfd_secret": 447, "shmget": 29, "shmat": 30, "msgget": 68}),
     "aarch64": (0xC00000B7, {"clone": 220, "clone3": 435, "execve": 221, "execveat": 281, "ptrace": 117,
                              "process_vm_readv": 270, "process_vm_writev": 271, "unshare": 97, "setns": 268,
                              "mount": 40, "umount2": 39, "pivot_root": 41, "chroot": 51, "bpf": 280,
                              "perf_event_open": 241, "io_uring_setup": 425, "userfaultfd": 282,
                              "kexec_load": 104, "init_module": 105, "finit_module": 273, "socket": 198,
-                             "keyctl": 219, "add_key": 217, "request_key": 218}),
+                             "keyctl": 219, "add_key": 217, "request_key": 218, "socketpair": 199,
+                             "memfd_create": 279, "memfd_secret": 447, "shmget": 194, "shmat": 196,
+                             "msgget": 186}),
 }
 
 
@@ -133,10 +143,41 @@ def namespaces(req, applied, problems):
         applied.append("mount-namespace")
     except OSError as exc:
         problems.append(f"mount namespace incomplete ({exc})")
+    else:
+        try:
+            scratch_quota(req, applied)
+        except OSError as exc:
+            problems.append(f"no size limit on the scratch directory ({exc})")
     if libc.unshare(CLONE_NEWNET | CLONE_NEWIPC) == 0:
         applied.append("network-namespace")
     else:
         problems.append(f"no network namespace ({os.strerror(ctypes.get_errno())})")
+
+
+def scratch_quota(req, applied):
+    """A tmpfs of ``req["scratch"]`` bytes and files over the scratch directory (``box``), owned by the
+    unprivileged user: the submission's files, deleted or not, cannot take more disk or memory than that.
+    It lives in this mount namespace only and goes with it; the files the parent put into ``box`` (the
+    submission) are copied onto it first."""
+    quota, box = req.get("scratch"), req["box"]
+    if not quota:
+        return
+    files = []
+    for name in os.listdir(box):
+        p = os.path.join(box, name)
+        if os.path.isfile(p) and not os.path.islink(p):
+            with open(p, "rb") as fh:
+                files.append((name, fh.read(), os.stat(p).st_mode & 0o777))
+    _mount("tmpfs", box, "tmpfs", MS_NOSUID | MS_NODEV,
+           f"size={int(quota['bytes'])},nr_inodes={int(quota['files'])},mode=0700,"
+           f"uid={int(req['uid'])},gid={int(req['gid'])}")
+    for name, data, mode in files:
+        fd = os.open(os.path.join(box, name), os.O_WRONLY | os.O_CREAT | os.O_EXCL | os.O_CLOEXEC, mode)
+        with os.fdopen(fd, "wb") as fh:
+            fh.write(data)
+        os.chmod(os.path.join(box, name), mode)
+    applied.append(f"scratch directory: tmpfs of {int(quota['bytes']) // 2 ** 20} MiB, "
+                   f"{int(quota['files'])} files")
 
 
 # --- 2. unprivileged user ---------------------------------------------------------------------------------

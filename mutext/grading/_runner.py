@@ -32,8 +32,9 @@ import sys
 import threading
 import traceback
 
-MAX_STATES = 400   # larger "models" are almost certainly a bug, and would bloat the channel
-MAX_ARRAY = 100_000   # entries of a returned array (kind "array")
+# the parent's limits (the request carries them; it rejects larger values as malformed, whoever sent them)
+MAX_STATES = 200      # states, inputs and outputs of a returned model: larger ones are almost certainly a bug
+MAX_ARRAY = 100_000   # numbers in a returned array (kind "array") or model
 
 
 def _write(out, nonce, **event):
@@ -164,6 +165,11 @@ def _encode_ss(value, np, ct):
         mats[name] = np.asarray(M, dtype=float)
     if mats["A"].shape[0] > MAX_STATES:
         raise TypeError(f"the model has {mats['A'].shape[0]} states (more than {MAX_STATES})")
+    if max(mats["D"].shape) > MAX_STATES:
+        raise TypeError(f"the model has {mats['D'].shape[1]} inputs and {mats['D'].shape[0]} outputs "
+                        f"(more than {MAX_STATES})")
+    if sum(M.size for M in mats.values()) > MAX_ARRAY:
+        raise TypeError(f"the model's matrices hold more than {MAX_ARRAY} numbers")
     dt = value.dt
     return {"A": mats["A"].tolist(), "B": mats["B"].tolist(), "C": mats["C"].tolist(),
             "D": mats["D"].tolist(), "dt": None if dt is None else float(dt),
@@ -201,6 +207,8 @@ def _encode_array(value, np):
         arr = np.asarray(arr, dtype=float)
     except (TypeError, ValueError) as exc:
         raise TypeError(f"returned {arr.dtype} entries, expected numbers ({exc})") from None
+    if arr.ndim > 32:
+        raise TypeError(f"returned an array with {arr.ndim} dimensions")
     if arr.size > MAX_ARRAY:
         raise TypeError(f"returned an array with {arr.size} entries (more than {MAX_ARRAY})")
     return {"shape": list(arr.shape), "data": arr.ravel().tolist()}
@@ -215,8 +223,11 @@ def _decode_arg(a, ct):
 
 def serve(req, out):
     """Import the submission and run the jobs of the request ``req``, writing events to ``out``."""
+    global MAX_STATES, MAX_ARRAY
     nonce = req["nonce"]
     sub_path = req["submission"]
+    MAX_STATES = int(req.get("max_states", MAX_STATES))
+    MAX_ARRAY = int(req.get("max_elements", MAX_ARRAY))
 
     # Scientific stack first: its import is not student code and should not
     # count against the submission's time.

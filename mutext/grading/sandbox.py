@@ -98,6 +98,18 @@ FILE_SIZE_LIMIT = 64 * 2 ** 20
 MEMORY_LIMIT = 3 * 2 ** 30
 #: processes and threads of the unprivileged user (a fork bomb stops here even without seccomp)
 PROCESS_LIMIT = 64
+#: bytes and files (inodes) of the child's scratch directory in all (a tmpfs of this size in the root
+#: child's mount namespace; elsewhere the parent measures the directory and stops a child beyond it)
+SCRATCH_BYTES = 256 * 2 ** 20
+SCRATCH_FILES = 10_000
+#: seconds between two measurements of the scratch directory by the parent (where no tmpfs limits it)
+SCRATCH_CHECK_INTERVAL = 1.0
+#: states (and inputs, outputs) of a returned model, and numbers in a returned array or model: the
+#: parent rejects larger values before any computation (the child enforces the same limits)
+MAX_STATES = 200
+MAX_ELEMENTS = 100_000
+#: other ``*.py`` files of the submission's own directory the child's probe tries to read
+BATCH_PROBES = 20
 #: directories a root child never sees (covered by empty file systems), besides the package and checkout
 HIDDEN_DIRS = ("/root", "/home", "/autograder", "/srv", "/mnt", "/media", "/opt", "/var/tmp", "/dev/shm", "/run")
 #: system directories a Landlock-confined child may read
@@ -228,31 +240,74 @@ def _extra_paths() -> list:
 
 
 def _read_rules(tree: str, excluded: list) -> tuple:
-    """Landlock read rules for ``tree`` minus ``excluded``: ``(full, list_only)`` lists of paths.
+    """Landlock read rules for ``tree`` minus ``excluded``: ``(full, list_only)`` lists of real paths.
 
     A directory on the way to an excluded path may be listed but only its
     other entries may be read (a ``pip install`` into site-packages puts the
-    package beside the libraries the child needs)."""
+    package beside the libraries the child needs).  Everything is decided on
+    real paths: a Landlock rule holds for the file or directory a path leads
+    to, so a symbolic link (a virtual environment's ``lib64 -> lib``) is
+    never given a rule of its own: inside ``tree`` its target has its own
+    rules, a target outside gets none from here (the Python installation
+    and the system directories have rules of their own)."""
+    tree = _real(tree)
+    excluded = [_real(e) for e in excluded]
     inner = [e for e in excluded if _under(e, tree)]
+    if tree in inner:
+        return [], []
     if not inner:
         return [tree], []
-    if tree in inner or not os.path.isdir(tree):
+    if not os.path.isdir(tree):
         return [], []
     full, listing = [], [tree]
     try:
-        names = os.listdir(tree)
+        names = sorted(os.listdir(tree))
     except OSError:
         return [], []
     for name in names:
         p = os.path.join(tree, name)
-        f, ls = _read_rules(p, inner)
+        if _real(p) != p:
+            continue
+        f, ls = _read_rules(p, excluded)
         full += f
         listing += ls
     return full, listing
 
 
-def _probe_files(extra_modules) -> list:
-    """Files the child must not be able to read: the solutions, the grader, answer-holding modules."""
+def _safe_rules(paths: list, secret: list, listing: bool = False) -> list:
+    """``paths`` without those whose real path the child may not have: a read rule must lead to a place
+    :func:`_allowed_path` allows (not the package or the grader, not the checkout outside its virtual
+    environment) that holds no secret root; a listing rule (names only) must not lead into a secret root
+    (but the Python installation inside a checkout is fine)."""
+    out = []
+    for p in paths:
+        r = _real(p)
+        if listing:
+            if any(_under(r, s) for s in secret) and not _allowed_path(r):
+                continue
+        elif not _allowed_path(r) or any(_under(s, r) for s in secret):
+            continue
+        out.append(p)
+    return out
+
+
+def _batch_files(submission) -> list:
+    """The submission's original file and, in its directory, the other ``*.py`` files (a class's
+    submissions side by side): the child works on a copy and must not read any of them."""
+    out = []
+    for p in dict.fromkeys([os.path.abspath(os.fspath(submission)), _real(submission)]):
+        out.append(p)
+        try:
+            names = sorted(n for n in os.listdir(os.path.dirname(p)) if n.endswith(".py"))
+        except OSError:
+            continue
+        out += [os.path.join(os.path.dirname(p), n) for n in names[:BATCH_PROBES + 1]]
+    return [p for p in dict.fromkeys(out) if os.path.isfile(p)]
+
+
+def _probe_files(extra_modules, submission=None) -> list:
+    """Files the child must not be able to read: the solutions, the grader, answer-holding modules, the
+    submission's original file and its batch-mates."""
     out = []
     grading = Path(__file__).resolve().parent
     if GRADER_DIR is not None:
@@ -267,6 +322,7 @@ def _probe_files(extra_modules) -> list:
     if CHECKOUT is not None:
         out += [str(CHECKOUT / ".git" / "HEAD"), str(CHECKOUT / "tests" / "conftest.py"),
                 str(CHECKOUT / "pyproject.toml")]
+    out += _batch_files(submission) if submission is not None else []
     return [p for p in dict.fromkeys(out) if os.path.isfile(p)]
 
 
@@ -311,10 +367,13 @@ def _nobody():
     return uid, gid
 
 
-def _hide_plan(keep: list, workdir: str) -> list:
-    """``[[dir, [kept paths inside it]], ...]`` for the root child's mount namespace, outermost first."""
+def _hide_plan(keep: list, workdir: str, submission=None) -> list:
+    """``[[dir, [kept paths inside it]], ...]`` for the root child's mount namespace, outermost first
+    (the submission's own directory too: its batch-mates)."""
     secret = _secret_roots()
-    dirs = [*HIDDEN_DIRS, tempfile.gettempdir(), os.path.dirname(workdir), *secret]
+    own = ([os.path.dirname(os.path.abspath(os.fspath(submission))), os.path.dirname(_real(submission))]
+           if submission is not None else [])
+    dirs = [*HIDDEN_DIRS, tempfile.gettempdir(), os.path.dirname(workdir), *secret, *own]
     dirs = sorted({_real(d) for d in dirs if os.path.isdir(d) and _real(d) != "/"}, key=len)
     plan = []
     for d in dirs:
@@ -325,6 +384,248 @@ def _hide_plan(keep: list, workdir: str) -> list:
             continue   # already invisible
         plan.append([d, [k for k in keep if _under(k, d) and k != d]])
     return plan
+
+
+# ----------------------------------------------------------------------------------------------------------
+# the child's files: measured and removed whatever their depth, names or permissions
+# ----------------------------------------------------------------------------------------------------------
+
+_DIR_FLAGS = os.O_RDONLY | getattr(os, "O_DIRECTORY", 0) | getattr(os, "O_NOFOLLOW", 0) | getattr(os, "O_CLOEXEC", 0)
+
+
+class _TreeChanged(OSError):
+    """A directory was moved while the tree was walked."""
+
+
+def _fix_perms() -> bool:
+    # as root nothing needs it (and a chmod must never follow a link the child swapped in); as the
+    # child's own user, restoring the owner's rights is how the grader gets back into a chmod 000 directory
+    return not (hasattr(os, "geteuid") and os.geteuid() == 0)
+
+
+def _open_dir(name, dir_fd, fix):
+    try:
+        return os.open(name, _DIR_FLAGS, dir_fd=dir_fd)
+    except PermissionError:
+        if not fix or not hasattr(os, "O_PATH"):
+            raise
+        # through a descriptor of what is there now: a link swapped in is not followed
+        pfd = os.open(name, os.O_PATH | os.O_NOFOLLOW | os.O_CLOEXEC, dir_fd=dir_fd)
+        try:
+            os.chmod(f"/proc/self/fd/{pfd}", 0o700)
+        finally:
+            os.close(pfd)
+        return os.open(name, _DIR_FLAGS, dir_fd=dir_fd)
+
+
+def _list_fd(fd, fix):
+    if fix and (os.fstat(fd).st_mode & 0o700) != 0o700:
+        os.fchmod(fd, 0o700)
+    return os.listdir(fd)
+
+
+def _walk_tree(top, fix=None):
+    """Every entry below the directory ``top``, children before their directory, as
+    ``(dir_fd, name, stat, depth)`` (``dir_fd`` is the open directory that holds ``name``, valid until the
+    next step; ``depth`` 0 for entries of ``top`` itself).
+
+    Iterative and descriptor-based: one directory is open at a time (going up through ``..``, checked to be
+    the directory it came from), names are relative to it, so neither the depth of the tree (recursion,
+    path length) nor links (never followed) stop or mislead it; a directory without rights for its owner
+    gets them back first (see :func:`_fix_perms`).  Entries on another file system are reported, not entered.
+    """
+    import stat as st_
+    fix = _fix_perms() if fix is None else fix
+    fd = os.open(top, _DIR_FLAGS)
+    try:
+        here = os.fstat(fd)
+        dev = here.st_dev
+        ident = (here.st_dev, here.st_ino)
+        names = _list_fd(fd, fix)
+        stack = []          # (name, sibling names still to visit, identity) of the directories above
+        while True:
+            if names:
+                name = names.pop()
+                try:
+                    est = os.stat(name, dir_fd=fd, follow_symlinks=False)
+                except FileNotFoundError:
+                    continue
+                if st_.S_ISDIR(est.st_mode) and est.st_dev == dev:
+                    try:
+                        child = _open_dir(name, fd, fix)
+                    except FileNotFoundError:
+                        continue
+                    cst = os.fstat(child)
+                    if (cst.st_dev, cst.st_ino) != (est.st_dev, est.st_ino):
+                        os.close(child)
+                        raise _TreeChanged(f"{name} changed while the tree was walked")
+                    try:
+                        sub = _list_fd(child, fix)
+                    except OSError:
+                        os.close(child)
+                        raise
+                    stack.append((name, names, ident))
+                    os.close(fd)
+                    fd, ident, names = child, (cst.st_dev, cst.st_ino), sub
+                    continue
+                yield fd, name, est, len(stack)
+                continue
+            if not stack:
+                return
+            name, names, up = stack.pop()
+            parent = os.open("..", _DIR_FLAGS, dir_fd=fd)
+            pst = os.fstat(parent)
+            if (pst.st_dev, pst.st_ino) != up:
+                os.close(parent)
+                raise _TreeChanged("a directory was moved while the tree was walked")
+            done = os.fstat(fd)
+            os.close(fd)
+            fd, ident = parent, up
+            yield fd, name, done, len(stack)
+    finally:
+        os.close(fd)
+
+
+def _remove_tree(top, keep=()) -> bool:
+    """Remove ``top`` and everything in it (or, with ``keep``, everything in it but the names ``keep`` of
+    its own entries); True if that was done.  Unlike :func:`shutil.rmtree`, no depth, path length or
+    permissions left by the child stop it (:func:`_walk_tree`)."""
+    import stat as st_
+    top = os.fspath(top)
+    if not os.path.lexists(top):
+        return True
+    try:
+        if os.path.islink(top) or not os.path.isdir(top):
+            os.unlink(top)
+            return True
+        for _ in range(3):      # a tree that changed under the walk (it cannot once the child is gone)
+            try:
+                for dir_fd, name, est, depth in _walk_tree(top):
+                    if depth == 0 and name in keep:
+                        continue
+                    try:
+                        if st_.S_ISDIR(est.st_mode):
+                            os.rmdir(name, dir_fd=dir_fd)
+                        else:
+                            os.unlink(name, dir_fd=dir_fd)
+                    except FileNotFoundError:
+                        pass
+                break
+            except _TreeChanged:
+                continue
+        if not keep:
+            os.rmdir(top)
+        return True
+    except OSError:
+        return False
+
+
+def _tree_use(top, max_bytes, max_files, seen=None) -> tuple:
+    """``(bytes, files)`` below ``top`` (disk blocks, entries), counting stops as soon as either exceeds its
+    maximum (a child's flood of files costs the grader no more than that)."""
+    import stat as st_
+    seen = set() if seen is None else seen
+    used = files = 0
+    for _fd, _name, est, _depth in _walk_tree(top):
+        files += 1
+        if st_.S_ISREG(est.st_mode):
+            if est.st_nlink > 1:
+                if (est.st_dev, est.st_ino) in seen:
+                    continue
+                seen.add((est.st_dev, est.st_ino))
+            used += max(getattr(est, "st_blocks", 0) * 512, 0) or est.st_size
+        if used > max_bytes or files > max_files:
+            break
+    return used, files
+
+
+def _held_deleted(pid) -> int:
+    """Bytes of deleted files the process ``pid`` still holds open or mapped (they take disk space that
+    no listing of the directory shows)."""
+    import stat as st_
+    total, seen = 0, set()
+    try:
+        for n in os.listdir(f"/proc/{pid}/fd"):
+            try:
+                est = os.stat(f"/proc/{pid}/fd/{n}")
+            except OSError:
+                continue
+            if st_.S_ISREG(est.st_mode) and est.st_nlink == 0 and (est.st_dev, est.st_ino) not in seen:
+                seen.add((est.st_dev, est.st_ino))
+                total += est.st_blocks * 512
+        with open(f"/proc/{pid}/maps") as fh:
+            for line in fh:
+                if line.endswith(" (deleted)\n") and "/memfd:" not in line and "/SYSV" not in line:
+                    lo, hi = line.split(None, 1)[0].split("-")
+                    total += int(hi, 16) - int(lo, 16)
+    except OSError:
+        pass
+    return total
+
+
+class _Scratch:
+    """The parent's watch over the disk a child uses: its scratch directory, deleted files it holds, and
+    (as root, when neither a mount namespace nor Landlock kept it out of them) what the unprivileged user
+    created in the shared temporary directories during the run."""
+
+    SHARED = ("/tmp", "/var/tmp", "/dev/shm")
+
+    def __init__(self, box, uid):
+        self.box, self.uid = str(box), uid
+        self.shared = uid is not None and os.name == "posix"
+        self.before = {d: self._names(d) for d in self.SHARED} if self.shared else {}
+        self.failures = 0
+
+    @staticmethod
+    def _names(d):
+        try:
+            return set(os.listdir(d))
+        except OSError:
+            return set()
+
+    def strays(self):
+        """Entries of the shared temporary directories that the child's user created during the run."""
+        out = []
+        for d, before in self.before.items():
+            for n in self._names(d) - before:
+                p = os.path.join(d, n)
+                try:
+                    if os.lstat(p).st_uid == self.uid:
+                        out.append(p)
+                except OSError:
+                    pass
+        return out
+
+    def over(self, pid):
+        """Why the child uses too much disk, or None."""
+        try:
+            seen = set()
+            used, files = _tree_use(self.box, SCRATCH_BYTES, SCRATCH_FILES, seen)
+            for p in (self.strays() if self.shared else []):
+                if os.path.isdir(p) and not os.path.islink(p):
+                    b, f = _tree_use(p, SCRATCH_BYTES - used, SCRATCH_FILES - files, seen)
+                else:
+                    est = os.lstat(p)
+                    b, f = est.st_blocks * 512, 0
+                used, files = used + b, files + f + 1
+            used += _held_deleted(pid)
+            self.failures = 0
+        except OSError:
+            self.failures += 1       # a tree changing all the time cannot hide from the measurement
+            return (None if self.failures < 3 else
+                    "its files could not be measured (they kept changing)")
+        if used > SCRATCH_BYTES:
+            return f"it wrote more than {SCRATCH_BYTES // 2 ** 20} MiB of files"
+        if files > SCRATCH_FILES:
+            return f"it created more than {SCRATCH_FILES} files and directories"
+        return None
+
+    def clean(self, keep=("submission.py",)):
+        """Empty the scratch directory (but ``keep``) and remove what the child left in shared places."""
+        ok = _remove_tree(self.box, keep=keep)
+        for p in (self.strays() if self.shared else []):
+            ok = _remove_tree(p) and ok
+        return ok
 
 
 # ----------------------------------------------------------------------------------------------------------
@@ -363,34 +664,50 @@ class _Events:
     """Reads complete lines appended to the results file, keeping those with our nonce.
 
     Lines are decoded defensively: only JSON objects (plain data) are kept,
-    malformed or absurdly nested lines are dropped."""
+    malformed or absurdly nested lines are dropped, and so is a line longer
+    than :attr:`MAX_LINE` bytes, unread (the parent reads at most that much
+    of it at a time, not the whole line)."""
 
     MAX_LINE = 16 * 2 ** 20
 
     def __init__(self, path, nonce):
         self.path, self.nonce, self.pos = path, nonce, 0
+        self.skipping = False     # inside a line that is too long: drop everything up to its end
 
     def read(self):
         try:
             with open(self.path, "rb") as fh:
                 fh.seek(self.pos)
-                data = fh.read()
+                data = fh.read(self.MAX_LINE + 1)
         except FileNotFoundError:
             return []
-        end = data.rfind(b"\n")
-        if end < 0:
-            return []
-        self.pos += end + 1
         out = []
-        for line in data[:end].splitlines():
-            if len(line) > self.MAX_LINE:
+        while data:
+            end = data.find(b"\n") if self.skipping else data.rfind(b"\n")
+            if self.skipping:
+                if end < 0:
+                    self.pos += len(data)
+                    return out
+                self.pos += end + 1
+                data = data[end + 1:]
+                self.skipping = False
                 continue
-            try:
-                ev = json.loads(line)
-            except Exception:   # noqa: BLE001 - ValueError, RecursionError: not ours
-                continue
-            if isinstance(ev, dict) and ev.get("nonce") == self.nonce:
-                out.append(ev)
+            if end < 0:
+                if len(data) > self.MAX_LINE:
+                    self.pos += len(data)
+                    self.skipping = True
+                return out
+            self.pos += end + 1
+            for line in data[:end].splitlines():
+                if len(line) > self.MAX_LINE:
+                    continue
+                try:
+                    ev = json.loads(line)
+                except Exception:   # noqa: BLE001 - ValueError, RecursionError: not ours
+                    continue
+                if isinstance(ev, dict) and ev.get("nonce") == self.nonce:
+                    out.append(ev)
+            return out
         return out
 
 
@@ -404,27 +721,47 @@ def _module_dir(name):
 
 
 def _number(x):
-    return isinstance(x, (int, float)) and not isinstance(x, bool)
+    return (isinstance(x, float) or (isinstance(x, int) and not isinstance(x, bool) and abs(x) <= 2 ** 63))
 
 
-def _matrix(m):
-    return isinstance(m, list) and all(isinstance(r, list) and all(_number(v) for v in r) for r in m)
+def _size(n, cap=MAX_STATES):
+    return isinstance(n, int) and not isinstance(n, bool) and 0 <= n <= cap
+
+
+def _matrix(m, rows, cols):
+    """``m`` is a list of ``rows`` lists of ``cols`` numbers (``cols`` None: any one length)."""
+    if not (isinstance(m, list) and len(m) == rows and all(isinstance(r, list) for r in m)):
+        return False
+    if rows and cols is None:
+        cols = len(m[0])
+    return all(len(r) == cols for r in m) and all(_number(v) for r in m for v in r)
 
 
 def _valid_value(kind, v):
-    """A value sent by the child has the plain shape its kind promises."""
+    """A value sent by the child has the plain shape its kind promises, within the size limits
+    (:data:`MAX_STATES`, :data:`MAX_ELEMENTS`): sizes are checked before any number is looked at."""
     if kind == "float":
         return _number(v)
     if kind == "array":
         if not (isinstance(v, dict) and isinstance(v.get("shape"), list) and isinstance(v.get("data"), list)):
             return False
         shape = v["shape"]
-        return (all(isinstance(n, int) and not isinstance(n, bool) and n >= 0 for n in shape)
-                and math.prod(shape) == len(v["data"]) and all(_number(x) for x in v["data"]))
+        return (len(shape) <= 32 and all(_size(n, MAX_ELEMENTS) for n in shape)
+                and math.prod(shape) == len(v["data"]) <= MAX_ELEMENTS and all(_number(x) for x in v["data"]))
     if kind == "ss":
-        return (isinstance(v, dict) and all(_matrix(v.get(k)) for k in "ABCD")
-                and (v.get("dt") is None or _number(v.get("dt")))
-                and all(isinstance(v.get(k, []), list) and all(isinstance(x, str) for x in v.get(k, []))
+        if not (isinstance(v, dict) and all(isinstance(v.get(k), list) for k in "ABCD")):
+            return False
+        A, B, C, D = (v[k] for k in "ABCD")
+        n, p = len(A), len(D)
+        m = len(D[0]) if p and isinstance(D[0], list) else (len(B[0]) if n and isinstance(B[0], list) else 0)
+        if not (_size(n) and _size(p) and _size(m) and len(C) == p and (n or not B)
+                and n * n + n * m + p * n + p * m <= MAX_ELEMENTS):
+            return False
+        if not (_matrix(A, n, n) and _matrix(B, n, m) and _matrix(C, p, n) and _matrix(D, p, m)):
+            return False
+        return ((v.get("dt") is None or _number(v.get("dt")))
+                and all(isinstance(v.get(k, []), list) and len(v.get(k, [])) <= MAX_STATES
+                        and all(isinstance(x, str) and len(x) <= 200 for x in v.get(k, []))
                         for k in ("inputs", "outputs")))
     return False
 
@@ -464,8 +801,14 @@ def _confinement(ev, mode):
     return "none", details
 
 
-def _run_once(workdir, plan, jobs, time_limit, outcomes, imp, log, state):
-    """Start one child for ``jobs``; fill ``outcomes``/``imp``; return the phase that was cut short."""
+def _run_once(workdir, plan, jobs, time_limit, outcomes, imp, log, state, scratch=None, total_limit=None):
+    """Start one child for ``jobs``; fill ``outcomes``/``imp``; return the phase that was cut short as
+    ``(phase, status, exit code or reason)``.
+
+    ``total_limit``: seconds for the whole submission, counted from the first child's boot (``state``
+    keeps that time across children); beyond it the child is stopped with status ``"budget"``.
+    ``scratch`` (a :class:`_Scratch`) is measured every :data:`SCRATCH_CHECK_INTERVAL` seconds; a child
+    over the disk budget is stopped with status ``"disk"``."""
     nonce = secrets.token_hex(16)
     results = workdir / f"results-{nonce}.jsonl"
     request = workdir / f"request-{nonce}.json"
@@ -494,6 +837,7 @@ def _run_once(workdir, plan, jobs, time_limit, outcomes, imp, log, state):
     order = ["import"] + [t.id for t in jobs] if imp.status == "not_run" else [t.id for t in jobs]
     kinds = {t.id: (t.kind, len(t.calls)) for t in jobs}
     phase, t0, cut, started = "startup", time.monotonic(), None, time.monotonic()
+    next_check = started + SCRATCH_CHECK_INTERVAL
     stage = "startup"        # startup -> confined -> booted: each event is accepted once, in order
     nxt = 0                  # index in ``order`` of the next phase allowed to start
     delay = 0.01
@@ -505,10 +849,19 @@ def _run_once(workdir, plan, jobs, time_limit, outcomes, imp, log, state):
             if kind == "confined" and stage == "startup":
                 stage = "confined"
                 state["isolation"], state["details"] = _confinement(ev, plan["mode"])
+                applied = [str(a) for a in ev.get("applied") or []]
+                if scratch is not None and any(a == "mount-namespace" or a.startswith("landlock") for a in applied):
+                    scratch.shared = False      # the child could not write into the shared directories
+                if not any(a.startswith("scratch directory") for a in applied):
+                    state["details"].append(
+                        f"scratch directory: no tmpfs of its own; {FILE_SIZE_LIMIT // 2 ** 20} MiB per file, "
+                        f"the grader stops the child beyond {SCRATCH_BYTES // 2 ** 20} MiB or {SCRATCH_FILES} "
+                        f"files (measured every {SCRATCH_CHECK_INTERVAL:g} s)")
                 if ev.get("fatal"):
                     state["fatal"] = str(ev["fatal"])[:500]
             elif kind == "boot" and stage == "confined":
                 stage, phase, t0 = "booted", None, now
+                state.setdefault("booted_at", now)
             elif stage != "booted":
                 continue
             elif kind == "start" and phase is None and nxt < len(order) and p == order[nxt]:
@@ -541,10 +894,21 @@ def _run_once(workdir, plan, jobs, time_limit, outcomes, imp, log, state):
         # submission started holding the interpreter) must not stall grading either
         limit = STARTUP_LIMIT if phase == "startup" else time_limit
         now = time.monotonic()
+        if total_limit is not None and "booted_at" in state and now - state["booted_at"] > total_limit:
+            _kill(proc)
+            cut = (phase, "budget", None)
+            break
         if now - t0 > limit or now - started > budget:
             _kill(proc)
             cut = (phase, "timeout", None)
             break
+        if scratch is not None and now >= next_check:
+            why = scratch.over(proc.pid)
+            next_check = time.monotonic() + SCRATCH_CHECK_INTERVAL
+            if why:
+                _kill(proc)
+                cut = (phase, "disk", why)
+                break
         time.sleep(delay)
         delay = min(0.05, delay * 1.5)
     with open(errpath, "rb") as fh:
@@ -576,7 +940,8 @@ def _prepare(workdir: Path, submission, extra_modules) -> dict:
             f, ls = _read_rules(_real(d), secret)
             full += f
             listing += ls
-    full += [str(lib), "/dev/urandom", "/dev/random", "/dev/zero"]
+    full = _safe_rules(full, secret) + [str(lib), "/dev/urandom", "/dev/random", "/dev/zero"]
+    listing = _safe_rules(listing, secret, listing=True)
     keep = python + [str(box), str(lib)]
     staged = lib / PACKAGE_ROOT.name
     blocked = [str(d) for d in PROTECTED_DIRS + [_module_dir(m) for m in extra_modules]]
@@ -586,10 +951,12 @@ def _prepare(workdir: Path, submission, extra_modules) -> dict:
     return {
         "mode": mode, "uid": uid, "gid": gid, "skip": list(SKIP),
         "box": str(box), "lib": str(lib), "submission": str(sub), "runner": str(RUNNER),
-        "hide": _hide_plan(keep, str(workdir)) if mode == "root" else [],
+        "hide": _hide_plan(keep, str(workdir), submission) if mode == "root" else [],
+        "scratch": {"bytes": SCRATCH_BYTES, "files": SCRATCH_FILES},
+        "max_states": MAX_STATES, "max_elements": MAX_ELEMENTS,
         "read": full, "list": listing, "write": [str(box), "/dev/null"],
         "python_dirs": python, "extra_paths": _extra_paths(),
-        "probe_read": _probe_files(extra_modules), "probe_write": _probe_dirs(workdir),
+        "probe_read": _probe_files(extra_modules, submission), "probe_write": _probe_dirs(workdir),
         "rlimits": {"as": MEMORY_LIMIT, "fsize": FILE_SIZE_LIMIT, "core": 0, "nofile": 1024,
                     **({"nproc": PROCESS_LIMIT} if mode == "root" else {})},
         # the audit hook's lists (reports attempts; the confinement is what blocks them)
@@ -598,7 +965,8 @@ def _prepare(workdir: Path, submission, extra_modules) -> dict:
     }
 
 
-def run_submission(submission, jobs, time_limit: float = 60.0, blocked_modules=()) -> SandboxResult:
+def run_submission(submission, jobs, time_limit: float = 60.0, blocked_modules=(),
+                   total_limit: float | None = None) -> SandboxResult:
     """Import ``submission`` in a confined child process and run ``jobs``.
 
     Parameters
@@ -614,6 +982,11 @@ def run_submission(submission, jobs, time_limit: float = 60.0, blocked_modules=(
         Further ``mutext`` modules or packages (e.g. ``"mutext.rotor"``) the
         submission may neither import nor read, in addition to
         :data:`PROTECTED_MODULES` (an exercise whose answer the library computes).
+    total_limit : float, optional
+        Seconds of wall-clock time for the whole submission, restarted children
+        included (counted from the moment the first child has started Python);
+        the questions not graded by then score 0 ("grading time budget
+        spent").  Default: ``(number of questions + 2) * time_limit``.
 
     Returns
     -------
@@ -629,9 +1002,15 @@ def run_submission(submission, jobs, time_limit: float = 60.0, blocked_modules=(
     """
     if not (isinstance(time_limit, (int, float)) and math.isfinite(time_limit) and time_limit > 0):
         raise ValueError(f"time_limit must be a positive number of seconds, got {time_limit!r}")
+    if total_limit is None:
+        total_limit = (len(jobs) + 2) * float(time_limit)
+    if not (isinstance(total_limit, (int, float)) and math.isfinite(total_limit) and total_limit > 0):
+        raise ValueError(f"total_limit must be a positive number of seconds, got {total_limit!r}")
     workdir = Path(tempfile.mkdtemp(prefix="mutext-grade-"))
+    scratch = None
     try:
         plan = _prepare(workdir, submission, tuple(blocked_modules))
+        scratch = _Scratch(plan["box"], plan["uid"])
         sub = Path(plan["submission"])
         outcomes = {t.id: PhaseOutcome("not_run") for t in jobs}
         imp = PhaseOutcome("not_run")
@@ -639,13 +1018,33 @@ def run_submission(submission, jobs, time_limit: float = 60.0, blocked_modules=(
         state: dict = {}
         children = 0
         pending = list(jobs)
+        spent = (f"grading time budget spent ({total_limit:g} s for the whole submission, restarts of the "
+                 "grading process included)")
         while pending:
-            children += 1
-            cut = _run_once(workdir, plan, pending, time_limit, outcomes, imp, log, state)
+            if children:
+                scratch.clean()          # a restarted child starts with the scratch directory as it was
+                if time.monotonic() - state.get("booted_at", math.inf) > total_limit:
+                    cut = (None, "budget", None)
+                else:
+                    cut = None
+            if not children or cut is None:
+                children += 1
+                cut = _run_once(workdir, plan, pending, time_limit, outcomes, imp, log, state, scratch,
+                                total_limit)
             if "fatal" in state:
                 raise SandboxError(state["fatal"])
             if cut is not None:
-                phase, status, rc = cut
+                phase, status, why = cut
+                text = ""
+                if status == "budget":
+                    if imp.status == "not_run":
+                        imp.status, imp.error = "timeout", spent
+                    for o in outcomes.values():
+                        if o.status == "not_run":
+                            o.status, o.error = "timeout", spent
+                    break
+                if status == "disk":
+                    status, text = "crashed", f"the grading process was stopped: {why}"
                 if phase == "startup":
                     imp.status = status
                     imp.error = ("the grading process could not start" if status == "crashed"
@@ -653,14 +1052,16 @@ def run_submission(submission, jobs, time_limit: float = 60.0, blocked_modules=(
                 elif phase == "import":
                     imp.status = status
                     imp.error = (f"importing the submission took longer than {time_limit:g} s" if status == "timeout"
+                                 else text if cut[1] == "disk"
                                  else f"the submission ended the grading process while it was being imported "
-                                      f"({_exit_text(rc)})")
+                                      f"({_exit_text(why)})")
                 elif phase in outcomes:
                     o = outcomes[phase]
                     o.status = status
                     o.error = (f"time limit of {time_limit:g} s exceeded (an endless loop, or a very slow "
                                "computation?)" if status == "timeout"
-                               else f"the grading process ended while this question was running ({_exit_text(rc)})")
+                               else text if cut[1] == "disk"
+                               else f"the grading process ended while this question was running ({_exit_text(why)})")
             if imp.status == "not_run":
                 imp.status = "crashed"
                 imp.error = "the grading process stopped before the submission was imported"
@@ -689,7 +1090,9 @@ def run_submission(submission, jobs, time_limit: float = 60.0, blocked_modules=(
                              isolation=state.get("isolation", "none"),
                              isolation_details=state.get("details", ["the child did not report its confinement"]))
     finally:
-        shutil.rmtree(workdir, ignore_errors=True)
+        if scratch is not None and scratch.shared:
+            scratch.clean()
+        _remove_tree(workdir)
 
 
 def _exit_text(rc):
