@@ -1,23 +1,56 @@
 """Autograder of exercise ex03_free_decay: scores, feedback, integrity (mutext.sysid blocked).
 
 The submissions ``tests/grading_submissions/ex03_*.py``, the reference
-solution and the stub are graded once, two at a time in the background; the
-feedback of each diagnosis is also checked in-process on constructed answers.
+solution, the stub and one trivial submission are graded once on the inputs
+of one seed, two at a time in the background (the reference on two more
+seeds); the trivial submissions ``tests/grading_submissions/trivial/ex03_*.py``
+are scored in-process on several seeds (graded one by one with ``-m slow``);
+the feedback of each diagnosis is also checked in-process on constructed
+answers, and on the inputs of several seeds, that it never contains a
+reference value.
 """
+import importlib.util
 import math
+import re
 
 import numpy as np
 import pytest
 
-from grading_harness import ROOT, GradedSubmissions, full, q
+from grading_harness import ROOT, SUBS, GradedSubmissions, full, q
 from mutext import cli
 from mutext_grader import ex03_free_decay as ex03
 from mutext_grader import grade
 from mutext_grader.solutions import ex03_free_decay as sol
 
 EXERCISE = "ex03_free_decay"
-graded = GradedSubmissions(EXERCISE)
+SEED = 20250611                  # the inputs of the graded submissions (any seed must do)
+MORE_SEEDS = (7, 123456789)      # the reference solution scores full marks on these too
+TRIVIAL = {p.stem: p for p in (SUBS / "trivial").glob("ex03_*.py")}
+
+
+class SeededSubmissions(GradedSubmissions):
+    """:class:`GradedSubmissions` graded on the inputs of ``seed``, with the trivial submissions and the
+    reference on further seeds (``"reference@7"``)."""
+
+    def __init__(self, exercise, seed, more_seeds=()):
+        super().__init__(exercise)
+        self.seed = seed
+        self.paths["ex03_constants"] = TRIVIAL["ex03_constants"]
+        self.runs = {n: (p, seed) for n, p in self.paths.items()}
+        self.runs.update({f"reference@{s}": (self.paths["reference"], s) for s in more_seeds})
+
+    def __call__(self, name):
+        with self._lock:
+            if not self._futures:
+                for n in sorted(self.runs, key=lambda n: not n.startswith("reference")):
+                    path, seed = self.runs[n]
+                    self._futures[n] = self._pool.submit(grade, self.exercise, path, self.timeout, seed=seed)
+        return self._futures[name].result()
+
+
+graded = SeededSubmissions(EXERCISE, SEED, MORE_SEEDS)
 SUBMISSIONS = graded.paths
+CASES = ex03.draw(np.random.default_rng(SEED))       # the inputs the submissions above were graded on
 
 
 # ----------------------------------------------------------------------------
@@ -28,7 +61,67 @@ def test_reference_solution_scores_full_marks():
     rep = graded("reference")
     assert rep.max_score == 10
     assert [x.max_score for x in rep.questions] == [1.5, 1.5, 1.5, 1.5, 2, 2]
+    assert [(x.id, x.name) for x in rep.questions] == [
+        ("a1", "(a1) natural_frequency: frequency from peak times, eq. 3.1 (rad/s)"),
+        ("a2", "(a2) damping_ratio: damping ratio from the log decrement, eq. 3.2"),
+        ("b1", "(b1) cart_mass: cart mass from the added mass, eq. 3.3"),
+        ("b2", "(b2) stiffness: equivalent stiffness, eq. 3.4"),
+        ("c", "(c) damping_coefficient: damping coefficient, eq. 3.5"),
+        ("d", "(d) identify_cart: (m_c, k, c) from a bare and a weighted decay")]
     assert rep.score == 10, rep.text()
+    assert rep.inputs == f"drawn from seed {SEED}"
+
+
+@pytest.mark.parametrize("seed", MORE_SEEDS)
+def test_reference_solution_scores_full_marks_on_other_seeds(seed):
+    rep = graded(f"reference@{seed}")
+    assert rep.score == 10 and rep.inputs == f"drawn from seed {seed}", rep.text()
+
+
+def _load(path):
+    spec = importlib.util.spec_from_file_location(f"trivial_{path.stem}", path)
+    mod = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(mod)
+    return mod
+
+
+def _scores(qs, mod):
+    """Points per question of the functions of ``mod`` called in-process on the inputs of ``qs``."""
+    out = {}
+    for qid, qu in qs.items():
+        outcomes = []
+        for c in qu.calls:
+            try:
+                outcomes.append(_payload(getattr(mod, qu.function)(*c.args, **c.kwargs), qu.kind))
+            except Exception as exc:   # noqa: BLE001
+                outcomes.append({"ok": False, "error": repr(exc)})
+        out[qid] = qu.check(outcomes)[0]
+    return out
+
+
+@pytest.mark.parametrize("name", sorted(TRIVIAL))
+def test_trivial_submissions_score_zero(name):
+    """Constants (the thesis's cart), zeros, returned arguments and numpy one-liners that are not eqs.
+    3.1-3.5 (a plain FFT's largest bin, the first over the last sample) earn nothing, on any draw."""
+    mod = _load(TRIVIAL[name])
+    for seed in (SEED, 1, 2, 3, 4):
+        scores = _scores(_questions(seed), mod)
+        assert all(v == 0 for v in scores.values()), (seed, scores)
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("name", sorted(TRIVIAL))
+def test_trivial_submissions_graded_score_zero(name):
+    rep = grade(EXERCISE, TRIVIAL[name], 60.0, seed=SEED)
+    assert rep.score == 0 and all(x.status == "ok" for x in rep.questions), rep.text()
+
+
+def test_constants_are_named():
+    rep = graded("ex03_constants")
+    assert rep.score == 0
+    for qid in ("a1", "a2", "b1", "b2", "c"):
+        assert "every call returned the same value although the inputs differ" in q(rep, qid).output
+    assert q(rep, "d").output.count("every call returned the same value") == 3
 
 
 def test_stub_scores_zero_without_crashing():
@@ -66,7 +159,7 @@ def test_decrement_not_divided_by_cycles_is_named():
     rep = graded("ex03_decrement_not_per_cycle")
     a2 = q(rep, "a2")
     assert a2.score == 0
-    for n in (5, 8, 4):
+    for *_, n, _x0, _duration in CASES["a"]:
         assert f"zeta is {n} times too large" in a2.output
     assert full(rep, "a1", "b1", "b2", "c")
     d = q(rep, "d")
@@ -91,9 +184,13 @@ def _payload(x, kind):
     return {"ok": True, "value": float(x)}
 
 
+def _questions(seed):
+    return {x.id: x for x in ex03.questions(np.random.default_rng(seed))}
+
+
 @pytest.fixture(scope="module")
 def questions():
-    return {x.id: x for x in ex03.questions()}
+    return _questions(SEED)
 
 
 def _check(questions, qid, answer):
@@ -117,13 +214,13 @@ def test_references_are_the_simulated_parameters(questions):
         assert abs(wn / wd - 1) < ex03.RTOL_FREQ      # the undamped frequency passes too
 
 
-def test_solution_peaks_are_the_library_detector():
+def test_solution_peaks_are_the_library_detector(questions):
     """The solution writes out :func:`mutext.sysid.decay_peaks` (a submission may not import it):
     both find the same peaks on every record of the exercise, noisy ones included."""
     from mutext.sysid import decay_peaks
-    records = [ex03.record(*r[1:4]) for r in ex03.A_RECORDS]
-    for _, m_c, k, c, m_w, noise, seed in ex03.D_CARTS:
-        records += [ex03.record(m_c, k, c, noise, seed), ex03.record(m_c + m_w, k, c, noise, seed + 100)]
+    records = [c.args[:2] for c in questions["a1"].calls]
+    records += [args for c in questions["d"].calls for args in (c.args[0:2], c.args[2:4])]
+    assert len(records) == 7
     for t, y in records:
         for got, ref in zip(sol.peaks(t, y), decay_peaks(t, y)):
             np.testing.assert_allclose(got, ref, rtol=1e-12, atol=0)
@@ -217,6 +314,89 @@ def test_junk_values_get_no_factor_2_hint(questions):
         kind = questions[qid].kind
         score, fb = _check(questions, qid, lambda *a: [1.0, 1.0, 1.0] if kind == "array" else 1.0)
         assert not any("factor 2" in line for line in fb), (qid, fb)
+
+
+# ----------------------------------------------------------------------------
+# inputs drawn per run; no reference in the feedback
+# ----------------------------------------------------------------------------
+
+def test_inputs_depend_on_the_seed_only():
+    one, again, other = _questions(1), _questions(1), _questions(2)
+    for qid in one:
+        args = [c.args for c in one[qid].calls]
+        assert args == [c.args for c in again[qid].calls], qid             # the same seed: the same inputs
+        assert all(a != b for a, b in zip(args, [c.args for c in other[qid].calls])), qid
+    assert ex03.draw(np.random.default_rng(1)) == ex03.draw(np.random.default_rng(1))
+
+
+def test_draws_keep_the_thesis_difficulty():
+    """Over many seeds: carts within 30 % of the rig's, damping ratios where eqs. 3.1/3.2 hold, enough
+    cycles in every record, references of one question far enough apart for the rule on constants."""
+    for seed in range(40):
+        cases = ex03.draw(np.random.default_rng(seed))
+        for m, k, c, cycles, x0, duration in cases["a"]:
+            wn, wd, z = ex03.exact_values(m, k, c)
+            assert 0.008 <= z <= 0.1 and 3 <= cycles <= 8 and 2.6 <= duration <= 3.4
+            assert (cycles + 1.5) * ex03.TWO_PI / wd <= duration
+            frac = duration * wd / ex03.TWO_PI % 1
+            assert 0.3 < frac < 0.7                                  # between two FFT bins
+        assert ex03._separated([ex03.exact_values(*r[:3])[1] for r in cases["a"]], 1.05)
+        assert ex03._separated([ex03.exact_values(*r[:3])[2] for r in cases["a"]], 1.15)
+        for m_c, k, c, m_w, x0, durations, seeds in cases["d"]:
+            assert 1.38 <= m_w / m_c <= 2.81 and math.sqrt(k / (m_c + m_w)) >= ex03.MIN_OMEGA_W
+        for i in range(3):
+            assert ex03._separated([x[i] for x in cases["d"]], ex03.SEPARATION)
+
+
+def _formats(v):
+    """How a reference value could appear in a text."""
+    v = float(v)
+    out = {f"{v:.3g}", f"{v:.4g}", f"{v:.5g}", f"{v:.6g}", f"{v:g}", f"{v:.2f}", f"{v:.3f}", f"{v:.4f}"}
+    return {x for x in out if len(x.strip("-0.")) >= 3}
+
+
+def _leaks(text, values):
+    """The reference values found in ``text`` (as whole numbers, not as parts of longer ones)."""
+    return sorted(f for v in values for f in _formats(v)
+                  if re.search(r"(?<![\d.])" + re.escape(f) + r"(?![\d])", text))
+
+
+@pytest.mark.parametrize("seed", [SEED, 3, 99])
+def test_feedback_never_shows_a_reference(seed):
+    """Wrong answers of every kind (a hint's mistake, an arbitrary factor, a constant): neither the
+    feedback nor the labels contain a reference value or a cart's parameter."""
+    qs = _questions(seed)
+    hidden = []
+    for c in qs["a1"].calls:
+        hidden += [*c.params, *ex03.exact_values(*c.params)]
+    for c in qs["d"].calls:
+        hidden += list(c.params[:3])
+    hidden += [ex03.ref_mass(*c.args) for c in qs["b1"].calls]
+    hidden += [c.args[0] ** 2 * c.args[1] for c in qs["b2"].calls]
+    hidden += [2 * math.prod(c.args) for c in qs["c"].calls]
+    texts = [c.label for qu in qs.values() for c in qu.calls]
+    for qid, qu in qs.items():
+        right = getattr(sol, qu.function)
+        for wrong in (lambda *a: np.asarray(right(*a)) * 1.37, lambda *a: np.asarray(right(*a)) / ex03.TWO_PI,
+                      lambda *a: np.asarray(right(*a)) * 2, lambda *a: np.asarray(right(*a)) * 0.6,
+                      lambda *a: [1.0, 1.0, 1.0] if qu.kind == "array" else 1.0):
+            score, fb = qu.check([_payload(wrong(*c.args), qu.kind) for c in qu.calls])
+            assert score == 0, (qid, fb)
+            texts += fb
+    text = "\n".join(texts)
+    assert _leaks(text, hidden) == []
+    # the test can fail: the old feedback printed the reference
+    assert _leaks(f"expected {hidden[0]:.4g}, got 1", hidden)
+
+
+def test_an_added_mass_or_a_record_sample_is_no_answer():
+    """Returning an argument scores nothing on any draw (the draws keep arguments and answers apart)."""
+    for seed in range(12):
+        qs = _questions(seed)
+        for qid, answer in (("a2", lambda t, y, N: y[0]), ("a1", lambda t, y, N: float(N)),
+                            ("b1", lambda wc, ww, mw: mw), ("d", lambda *a: [a[-1]] * 3)):
+            score, fb = _check(qs, qid, answer)
+            assert score == 0, (seed, qid, fb)
 
 
 def test_factor_2_hint_only_near_2():

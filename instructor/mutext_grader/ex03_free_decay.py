@@ -291,11 +291,11 @@ def _float_score(outcomes, calls, expected, rtol, what, per_call, hint=None):
         if _near(x, ref, rtol):
             score += per_call
             continue
+        if _nan_text(x):
+            fb.append(f"[{call.label}] {what}: got {fmt(x)}; {_nan_text(x)}")
+            continue
         within = f"{rtol:.0e} relative" if rtol < 1e-3 else f"{rtol:.0%}"
         msg = f"[{call.label}] {what}: got {fmt(x)}, not within {within} of the right value"
-        if _nan_text(x):
-            fb.append(f"{msg}; {_nan_text(x)}")
-            continue
         tol = min(0.02, max(1e-4, 2 * rtol))
         extra = (hint(x, ref, call) if hint else None) or _ratio_hints(x / ref if ref else math.nan, what,
                                                                         tol=tol)
@@ -322,17 +322,16 @@ def _freq_hint(x, ref, call):
 def _zeta_hint(x, ref, call):
     N = call.cycles
     ratio = x / ref
-    if abs(ratio / (TWO_PI * N) - 1) < 0.05:
-        return [f"this is ln(y_0/y_N), the decrement over {N} cycles: divide by 2 pi N"]
-    if abs(ratio / TWO_PI - 1) < 0.05:
-        return ["this is the logarithmic decrement delta per cycle: zeta = delta / (2 pi)"]
-    if abs(ratio / N - 1) < 0.05:
-        return [f"zeta is {N} times too large: the decrement ln(y_0/y_N) spans N = {N} cycles, "
-                "divide it by N (eq. 3.2)"]
-    if abs(ratio * math.log(10) - 1) < 0.05:
-        return ["zeta is 1/ln(10) of the expected one: use the natural logarithm, not log10"]
-    if abs(ratio + 1) < 0.05:
-        return ["zeta is negative: the ratio is y_0 / y_N (earlier peak over later peak)"]
+    # the mistakes and the factors they give; the nearest within 5 % is named (N = 6 is near 2 pi)
+    known = [(TWO_PI * N, f"this is ln(y_0/y_N), the decrement over {N} cycles: divide by 2 pi N"),
+             (TWO_PI, "this is the logarithmic decrement delta per cycle: zeta = delta / (2 pi)"),
+             (N, f"zeta is {N} times too large: the decrement ln(y_0/y_N) spans N = {N} cycles, "
+                 "divide it by N (eq. 3.2)"),
+             (1 / math.log(10), "zeta is 1/ln(10) of the expected one: use the natural logarithm, not log10"),
+             (-1.0, "zeta is negative: the ratio is y_0 / y_N (earlier peak over later peak)")]
+    off, text = min((abs(ratio / f - 1), text) for f, text in known)
+    if off < 0.05:
+        return [text]
     return _ratio_hints(ratio, "damping ratio")
 
 
