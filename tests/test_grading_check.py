@@ -114,6 +114,17 @@ def test_reference_solutions_pass_the_check(name, capsys, reports):
     assert _floats(text) == [], text
 
 
+def test_a_laptop_without_isolation_still_checks(monkeypatch, capsys):
+    """Not confined (no Landlock, an old kernel, macOS): the check says so and does not fail on it."""
+    from mutext.grading import sandbox
+    monkeypatch.setattr(sandbox, "FORCE_MODE", "user")
+    monkeypatch.setattr(sandbox, "SKIP", ("landlock", "seccomp"))
+    assert main(["check", "ex04", str(SOLUTIONS / "ex04_beam_element.py")]) == 0
+    text = capsys.readouterr().out
+    assert "Isolation: none (your file was not confined on this machine" in text
+    assert "4 of 4 functions run and return the right kind of value" in text
+
+
 WRONG_EX04 = '''
 import numpy as np
 
@@ -150,9 +161,11 @@ def controller():
 def test_wrong_kinds_and_shapes_are_reported(tmp_path):
     (tmp_path / "wrong04.py").write_text(WRONG_EX04)
     (tmp_path / "wrong01.py").write_text(WRONG_EX01)
-    with ThreadPoolExecutor(max_workers=2) as pool:
+    (tmp_path / "wrong06.py").write_text(WRONG_EX06)
+    with ThreadPoolExecutor(max_workers=3) as pool:
         r04 = pool.submit(check, "ex04", tmp_path / "wrong04.py", 30)
         r01 = pool.submit(check, "ex01", tmp_path / "wrong01.py", 4)
+        r06 = pool.submit(check, "ex06", tmp_path / "wrong06.py", 30)
     r = r04.result()
     st = {f.function: f for f in r.functions}
     assert st["element_matrices"].status == "wrong_kind"
@@ -161,6 +174,8 @@ def test_wrong_kinds_and_shapes_are_reported(tmp_path):
     assert st["assemble"].status == "wrong_kind" and "expected a numpy array" in st["assemble"].messages[0]
     assert st["natural_frequencies"].ok
     assert st["relative_errors"].status == "missing"
+    assert st["relative_errors"].messages == ["your file defines no function relative_errors() (the name must be "
+                                              "exactly this)"]
     assert "1 of 4 functions run and return the right kind of value" in r.text() and not r.ok
 
     r = r01.result()
@@ -173,6 +188,31 @@ def test_wrong_kinds_and_shapes_are_reported(tmp_path):
     assert st["hinf_norm"].status == "wrong_kind" and "expected a single float" in st["hinf_norm"].messages[0]
     assert st["controller"].status == "timeout" and "time limit of 4 s" in st["controller"].messages[0]
     assert r.n_ok == 0
+
+    r = r06.result()
+    st = {f.function: f for f in r.functions}
+    assert st["sideband_frequencies"].status == "blocked"
+    assert "tried importing mutext.rotor" in st["sideband_frequencies"].messages[0]
+    assert st["sideband_size"].status == "wrong_kind"
+    assert "expected a float" in st["sideband_size"].messages[0]
+    assert st["classify"].status == "wrong_kind"
+    assert st["classify"].messages == ["classify() returned a number that is not one of 0, 1, 2 (an index, see the "
+                                       "docstring)"]
+
+
+WRONG_EX06 = '''
+import numpy as np
+
+def sideband_frequencies(natural_frequencies_hz, speed_hz, orders, f_min, f_max):
+    import mutext.rotor                   # blocked in this exercise
+    return np.zeros(3)
+
+def sideband_size(freq_hz, re, im, f_candidate, half_width_hz):
+    return np.ones((2, 2))
+
+def classify(freq_hz, re, im, natural_frequencies_hz, speed_hz, noise):
+    return 7
+'''
 
 
 RIGHT_SHAPE_WRONG_VALUES = '''

@@ -196,7 +196,10 @@ def _function_check(q, calls, outcome) -> FunctionCheck:
             key = ("wrong_kind", f"{q.function}() {problem}")
         else:
             err = str(res.get("error", ""))
-            key = (_call_error_kind(q.function, err), err)
+            kind = _call_error_kind(q.function, err)
+            if kind == "missing":
+                err = f"your file defines no function {q.function}() (the name must be exactly this)"
+            key = (kind, err)
         found.setdefault(key, []).append(i)
     if found:
         statuses = [s for s, _ in found]
