@@ -1,22 +1,54 @@
 """Autograder of exercise ex04_beam_element: scores, feedback, integrity (mutext.rotor blocked).
 
 The submissions ``tests/grading_submissions/ex04_*.py``, the reference
-solution and the stub are graded once, two at a time in the background; the
-feedback of each diagnosis is also checked in-process on constructed answers.
+solution, the stub and one trivial submission are graded once on the inputs
+of one seed, two at a time in the background (the reference on two more
+seeds); the trivial submissions ``tests/grading_submissions/trivial/ex04_*.py``
+are scored in-process on several seeds (graded one by one with ``-m slow``);
+the feedback of each diagnosis is also checked in-process on constructed
+answers, and that it never contains a reference value.
 """
+import importlib.util
 import math
+import re
 
 import numpy as np
 import pytest
 
-from grading_harness import ROOT, GradedSubmissions, full, q
+from grading_harness import ROOT, SUBS, GradedSubmissions, full, q
 from mutext import cli
 from mutext_grader import ex04_beam_element as ex04
+from mutext_grader import grade
 from mutext_grader.solutions import ex04_beam_element as sol
 
 EXERCISE = "ex04_beam_element"
-graded = GradedSubmissions(EXERCISE)
+SEED = 20250611                  # the inputs of the graded submissions (any seed must do)
+MORE_SEEDS = (7, 123456789)      # the reference solution scores full marks on these too
+TRIVIAL = {p.stem: p for p in (SUBS / "trivial").glob("ex04_*.py")}
+
+
+class SeededSubmissions(GradedSubmissions):
+    """:class:`GradedSubmissions` graded on the inputs of ``seed``, with one trivial submission and the
+    reference on further seeds (``"reference@7"``)."""
+
+    def __init__(self, exercise, seed, more_seeds=()):
+        super().__init__(exercise)
+        self.paths["ex04_oversized"] = TRIVIAL["ex04_oversized"]
+        self.runs = {n: (p, seed) for n, p in self.paths.items()}
+        self.runs.update({f"reference@{s}": (self.paths["reference"], s) for s in more_seeds})
+
+    def __call__(self, name):
+        with self._lock:
+            if not self._futures:
+                for n in sorted(self.runs, key=lambda n: not n.startswith("reference")):
+                    path, seed = self.runs[n]
+                    self._futures[n] = self._pool.submit(grade, self.exercise, path, self.timeout, seed=seed)
+        return self._futures[name].result()
+
+
+graded = SeededSubmissions(EXERCISE, SEED, MORE_SEEDS)
 SUBMISSIONS = graded.paths
+CASES = ex04.draw(np.random.default_rng(SEED))       # the inputs the submissions above were graded on
 
 
 # ----------------------------------------------------------------------------
@@ -26,8 +58,29 @@ SUBMISSIONS = graded.paths
 def test_reference_solution_scores_full_marks():
     rep = graded("reference")
     assert rep.max_score == 10 and [x.max_score for x in rep.questions] == [3, 2, 2, 3]
+    assert [(x.id, x.name) for x in rep.questions] == [
+        ("a", "(a) element_matrices: element stiffness and consistent mass matrices"),
+        ("b", "(b) assemble: global matrices with supports"),
+        ("c", "(c) natural_frequencies: natural frequencies in rad/s"),
+        ("d", "(d) relative_errors: convergence against the exact frequency")]
     assert rep.score == 10, rep.text()
+    assert rep.inputs == f"drawn from seed {SEED}"
     assert "h^4 convergence" in q(rep, "d").output
+
+
+@pytest.mark.parametrize("seed", MORE_SEEDS)
+def test_reference_solution_scores_full_marks_on_other_seeds(seed):
+    rep = graded(f"reference@{seed}")
+    assert rep.score == 10 and rep.inputs == f"drawn from seed {seed}", rep.text()
+
+
+def test_oversized_arrays_score_zero_unanalysed():
+    rep = graded("ex04_oversized")
+    assert rep.score == 0 and all(x.status == "ok" for x in rep.questions)
+    assert "must return the pair (K, M) of 4x4 arrays" in q(rep, "a").output
+    for n, *_ in CASES["b"]:
+        assert f"the matrices are 120x120, far larger than the {2 * n}x{2 * n} asked" in q(rep, "b").output
+    assert "got 5000 numbers" in q(rep, "c").output and "got 2000 numbers" in q(rep, "d").output
 
 
 def test_stub_scores_zero_without_crashing():
@@ -64,9 +117,13 @@ def test_supports_not_applied_is_named():
     assert full(rep, "a")
     b = q(rep, "b")
     assert b.score == 1.0                    # right free-beam matrices: half the points
-    assert "boundary conditions not applied: the matrices are 8x8" in b.output
-    assert "(w1, w4 for a pinned-pinned beam), leaving 6x6" in b.output
-    assert "w1, theta1 for a cantilever beam" in b.output
+    for n, _length, _mat, support in CASES["b"]:
+        size = 2 * (n + 1)
+        assert f"boundary conditions not applied: the matrices are {size}x{size}" in b.output
+        if support == "pinned":
+            assert f"(w1, w{n + 1} for a pinned-pinned beam), leaving {2 * n}x{2 * n}" in b.output
+        else:
+            assert f"(w1, theta1 for a cantilever beam), leaving {2 * n}x{2 * n}" in b.output
     c = q(rep, "c")
     assert c.score == 0
     assert "boundary conditions not applied: you have rigid-body zero frequencies" in c.output
@@ -81,7 +138,10 @@ def test_hz_and_pinned_beta_for_cantilever_are_named():
     d = q(rep, "d")
     assert d.score == 1                      # the pinned-pinned call is right
     assert "beta L = pi, which is the pinned-pinned value" in d.output
-    assert "beta_2 L = 4.6940911330" in d.output
+    from mutext.rotor.analytic import beta_l
+    for *_, support, mode in CASES["d"]:
+        if support == "cantilever":
+            assert f"beta_{mode} L = {beta_l('cantilever', mode):.10f}" in d.output
     assert rep.score == 6
 
 
@@ -109,8 +169,15 @@ def _payload(x):
     return {"ok": True, "value": {"shape": list(x.shape), "data": x.ravel().tolist()}}
 
 
+def _questions(seed=SEED):
+    return {x.id: x for x in ex04.questions(np.random.default_rng(seed))}
+
+
+_QUESTIONS = _questions()
+
+
 def _question(qid):
-    return next(x for x in ex04.questions() if x.id == qid)
+    return _QUESTIONS[qid]
 
 
 def _check(qid, answer):
@@ -272,6 +339,160 @@ def test_bad_payloads_are_reported():
     score, fb = qu.check([_payload(np.eye(4)), {"ok": False, "error": "boom"}])
     assert score == 0
     assert any("must return the pair (K, M)" in line for line in fb) and any("boom" in line for line in fb)
+
+
+# ----------------------------------------------------------------------------
+# inputs drawn per run; trivial answers; no reference in the feedback
+# ----------------------------------------------------------------------------
+
+def test_inputs_depend_on_the_seed_only():
+    one, again, other = _questions(1), _questions(1), _questions(2)
+    for qid in one:
+        args = [(c.args, c.kwargs) for c in one[qid].calls]
+        assert args == [(c.args, c.kwargs) for c in again[qid].calls], qid
+        assert all(a != b for a, b in zip(args, [(c.args, c.kwargs) for c in other[qid].calls])), qid
+    assert ex04.draw(np.random.default_rng(1)) == ex04.draw(np.random.default_rng(1))
+
+
+def test_prepare_builds_the_references_of_the_same_draw(monkeypatch):
+    """prepare(rng) gets a generator seeded as questions' one: it builds exactly the models the checks use."""
+    built = []
+    monkeypatch.setattr(ex04, "_free_free_cached", lambda *a: built.append(a) or (np.eye(2), np.eye(2)))
+    ex04.prepare(np.random.default_rng(5))
+    cases = ex04.draw(np.random.default_rng(5))
+    want = {(n, length, mat["E"], mat["d"], mat["rho"]) for n, length, mat, *_ in cases["b"] + cases["c"]}
+    want |= {(n, length, mat["E"], mat["d"], mat["rho"]) for length, mat, *_ in cases["d"] for n in (2, 4, 8)}
+    assert set(built) == want
+
+
+def test_draws_vary_what_matters():
+    """Over many seeds: element lengths far from 1 m (a wrong power of L shows), one beam of each support in
+    (b) and (c), the modes of (d) as listed, several materials and element counts."""
+    seen = {"E": set(), "n": set(), "modes": set()}
+    for seed in range(40):
+        cases = ex04.draw(np.random.default_rng(seed))
+        assert sorted(L > 1 for _, L in cases["a"]) == [False, True]
+        assert all(abs(math.log(L)) > 0.4 for _, L in cases["a"])
+        for key in ("b", "c"):
+            assert sorted(x[3] for x in cases[key]) == ["cantilever", "pinned"]
+        assert sorted(x[2] for x in cases["d"]) == ["cantilever", "cantilever", "pinned"]
+        seen["E"] |= {round(m["E"], -10) for m, _ in cases["a"]}
+        seen["n"] |= {x[0] for x in cases["b"] + cases["c"]}
+        seen["modes"] |= {(x[2], x[3]) for x in cases["d"]}
+    assert len(seen["E"]) >= 4 and seen["n"] == {3, 4, 5, 6}
+    assert seen["modes"] == {("pinned", 1), ("pinned", 2), ("cantilever", 1), ("cantilever", 2), ("cantilever", 3)}
+
+
+def _load(path):
+    spec = importlib.util.spec_from_file_location(f"trivial_{path.stem}", path)
+    mod = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(mod)
+    return mod
+
+
+@pytest.mark.parametrize("name", sorted(set(TRIVIAL) - {"ex04_oversized"}))
+def test_trivial_submissions_score_zero(name):
+    """Zeros, identity matrices scaled by the arguments, constants, and the closed-form frequencies in place
+    of the finite-element ones earn nothing, on any draw."""
+    mod = _load(TRIVIAL[name])
+    for seed in (SEED, 1, 2):
+        for qid, qu in _questions(seed).items():
+            outcomes = []
+            for c in qu.calls:
+                try:
+                    outcomes.append(_payload(getattr(mod, qu.function)(*c.args, **c.kwargs)))
+                except NotImplementedError as exc:
+                    outcomes.append({"ok": False, "error": repr(exc)})
+            score, fb = qu.check(outcomes)
+            assert score == 0, (seed, qid, fb)
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("name", sorted(TRIVIAL))
+def test_trivial_submissions_graded_score_zero(name):
+    rep = grade(EXERCISE, TRIVIAL[name], 60.0, seed=SEED)
+    assert rep.score == 0 and all(x.status == "ok" for x in rep.questions), rep.text()
+
+
+def test_oversized_arrays_are_never_factorised(monkeypatch):
+    """Sizes are checked before any computation: far larger arrays score 0 and reach no eigensolver."""
+    def refuse(*a, **k):
+        raise AssertionError("an eigensolver was called")
+
+    monkeypatch.setattr(ex04, "frequencies", refuse)
+    monkeypatch.setattr(ex04.sla, "eigh", refuse)
+    monkeypatch.setattr(ex04.sla, "eigvals", refuse)
+    big = np.eye(300)
+    for qid, value in (("a", np.stack([np.eye(60)] * 2)), ("b", np.stack([big, big])), ("c", np.ones(30000)),
+                       ("d", np.ones(30000))):
+        qu = _question(qid)
+        score, fb = qu.check([_payload(value) for _ in qu.calls])
+        assert score == 0 and len(fb) == len(qu.calls), fb
+        text = {"a": "must return the pair (K, M) of 4x4 arrays", "b": "300x300, far larger than the",
+                "c": "got 30000 numbers", "d": "got 30000 numbers"}[qid]
+        assert all(text in line for line in fb), fb
+
+
+def _formats(v):
+    v = float(v)
+    out = {f"{v:.3g}", f"{v:.4g}", f"{v:.5g}", f"{v:.6g}", f"{v:g}"}
+    return {x for x in out if len(x.strip("-0.")) >= 3}
+
+
+def _leaks(text, values):
+    return sorted(f for v in values for f in _formats(v)
+                  if re.search(r"(?<![\d.])" + re.escape(f) + r"(?![\d])", text))
+
+
+def _references(qs):
+    """Every reference value of the calls: matrix entries, frequencies, errors, exact frequencies."""
+    vals = []
+    for c in qs["a"].calls:
+        E, I, rho, A, L = c.args
+        vals += [x for X in ex04.element_reference(E, c.kwargs_ref["d"], rho, L)[:2] for x in X.ravel() if x]
+    for c in qs["b"].calls:
+        n, length, E, I, rho, A, support = c.args
+        vals += [x for X in ex04.supported(n, length, E, c.kwargs_ref["d"], rho, support) for x in X.ravel() if x]
+    for c in qs["c"].calls:
+        n, length, E, I, rho, A, support, k = c.args
+        vals += list(ex04.frequencies(*ex04.supported(n, length, E, c.kwargs_ref["d"], rho, support), k))
+    for c in qs["d"].calls:
+        length, E, I, rho, A, support = c.args
+        d, mode = c.kwargs_ref["d"], c.kwargs["mode"]
+        vals += list(ex04.reference_errors(length, E, d, rho, support, mode))
+        vals.append(ex04.exact_frequency(length, E, d, rho, support, mode))
+    return vals
+
+
+def test_feedback_never_shows_a_reference():
+    """Wrong answers of many kinds (hinted mistakes, arbitrary factors, another support, noise): the feedback
+    holds none of the reference values."""
+    rng = np.random.default_rng(0)
+    wrong = {
+        "a": [lambda *a: np.array(sol.element_matrices(*a)) * 1.37,
+              lambda *a: np.array(sol.element_matrices(*a)) * (1 + 0.01 * rng.standard_normal((2, 4, 4))),
+              lambda *a: (sol.element_matrices(*a)[0][np.ix_([0, 2, 1, 3], [0, 2, 1, 3])],
+                          sol.element_matrices(*a)[1] * 0.77)],
+        "b": [lambda *a: np.array(sol.assemble(*a)) * 1.37,
+              lambda *a: np.array(sol.assemble(*a)) * (1 + 0.01 * rng.standard_normal(np.shape(sol.assemble(*a))))],
+        "c": [lambda *a: sol.natural_frequencies(*a) * 1.37, lambda *a: sol.natural_frequencies(*a) / (2 * np.pi),
+              lambda *a: sol.natural_frequencies(*a) * (1 + 0.01 * rng.standard_normal(a[-1]))],
+        "d": [lambda *a, **k: sol.relative_errors(*a, **k) * 1.37,
+              lambda *a, **k: sol.relative_errors(*a, **k) + 1e-3,
+              lambda *a, **k: (1 + sol.relative_errors(*a, **k)) * 1.0123 - 1],
+    }
+    for seed in (SEED, 3):
+        qs = _questions(seed)
+        texts = [c.label for qu in qs.values() for c in qu.calls]
+        for qid, answers in wrong.items():
+            for answer in answers:
+                score, fb = qs[qid].check([_payload(answer(*c.args, **c.kwargs)) for c in qs[qid].calls])
+                assert score < ex04.POINTS[qid], (qid, fb)
+                texts += fb
+        refs = _references(qs)
+        text = "\n".join(texts)
+        assert _leaks(text, refs) == [], _leaks(text, refs)
+        assert _leaks(f"expected {refs[-1]:.6g}", refs)           # the check can fail
 
 
 def test_listed_and_stub_named():

@@ -466,7 +466,7 @@ def _check_assembly(outcomes, calls):
                 n_ok += 1
             else:
                 names = [_global_name(k) for k in np.setdiff1d(np.arange(2 * (n + 1)), fixed)]
-                fb.append(f"{tag} {which} is not right: {_worst_entry(X, Y, names)}; check the element matrices "
+                fb.append(f"{tag} {which} differs: {_worst_entry(X, Y, names)}; check the element matrices "
                           "of (a) and that overlapping entries are added")
     if n_ok == 2 * len(calls):
         fb.insert(0, "correct: K and M of both beams match")
