@@ -1,8 +1,11 @@
 r"""Exercise ex01: H-infinity control of the two-mass system.
 
-Fill in the four functions below, then grade your file with::
+Fill in the four functions below, then check that your file runs with::
 
-    mutext grade ex01_two_mass_hinf exercises/ex01_two_mass_hinf.py
+    mutext check ex01_two_mass_hinf exercises/ex01_two_mass_hinf.py
+
+(it says whether each function runs and returns the right kind of value; your instructor's
+grader scores it, on inputs drawn for your file)
 
 The system (book chapter "H-infinity control and LFTs"): mass ``m1`` hangs
 from mass ``m2`` through the spring ``k1``; the spring ``k2`` ties ``m2`` to

@@ -1,8 +1,11 @@
 r"""Exercise ex02: the structured singular value.
 
-Fill in the five functions below, then grade your file with::
+Fill in the five functions below, then check that your file runs with::
 
-    mutext grade ex02_mu exercises/ex02_mu.py
+    mutext check ex02_mu exercises/ex02_mu.py
+
+(it says whether each function runs and returns the right kind of value; your instructor's
+grader scores it, on inputs drawn for your file)
 
 For a complex matrix ``M`` (it maps the inputs ``w`` of the uncertainty
 channels to their outputs ``z``) and a set of structured perturbations

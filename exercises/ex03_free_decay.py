@@ -1,8 +1,11 @@
 r"""Exercise ex03: free-decay identification of a cart of the three-mass rig.
 
-Fill in the six functions below, then grade your file with::
+Fill in the functions below, then check that your file runs with::
 
-    mutext grade ex03_free_decay exercises/ex03_free_decay.py
+    mutext check ex03_free_decay exercises/ex03_free_decay.py
+
+(it says whether each function runs and returns the right kind of value; your instructor's
+grader scores it, on inputs drawn for your file)
 
 A cart is pulled aside and released from rest, its neighbours clamped, so it
 moves as the single degree of freedom

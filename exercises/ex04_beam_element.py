@@ -1,8 +1,11 @@
 r"""Exercise ex04: Euler-Bernoulli beam elements.
 
-Fill in the four functions below, then grade your file with::
+Fill in the four functions below, then check that your file runs with::
 
-    mutext grade ex04_beam_element exercises/ex04_beam_element.py
+    mutext check ex04_beam_element exercises/ex04_beam_element.py
+
+(it says whether each function runs and returns the right kind of value; your instructor's
+grader scores it, on inputs drawn for your file)
 
 A uniform beam bends in one plane: ``w(z)`` is its deflection (m) and
 ``theta(z) = dw/dz`` its slope (rad, counterclockwise positive), with ``z``

@@ -1,8 +1,11 @@
 r"""Exercise ex05: find the effect hidden in measured frequency responses.
 
-Fill in the four functions below, then grade your file with::
+Fill in the four functions below, then check that your file runs with::
 
-    mutext grade ex05_diagnose exercises/ex05_diagnose.py
+    mutext check ex05_diagnose exercises/ex05_diagnose.py
+
+(it says whether each function runs and returns the right kind of value; your instructor's
+grader scores it, on inputs drawn for your file)
 
 A lumped chain (masses, springs and dampers; matrices ``M``, ``C``, ``K`` in
 SI units) is the engineering model.  Its "measured" frequency responses come

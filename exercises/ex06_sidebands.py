@@ -1,8 +1,11 @@
 r"""Exercise ex06: predict and find the sidebands of a cracked rotor at speed.
 
-Fill in the three functions below, then grade your file with::
+Fill in the three functions below, then check that your file runs with::
 
-    mutext grade ex06_sidebands exercises/ex06_sidebands.py
+    mutext check ex06_sidebands exercises/ex06_sidebands.py
+
+(it says whether each function runs and returns the right kind of value; your instructor's
+grader scores it, on inputs drawn for your file)
 
 A rotor spinning at ``F`` Hz whose stiffness changes as it turns is linear
 time-periodic.  Forced at a frequency ``f`` it also responds at ``f + kF``,
