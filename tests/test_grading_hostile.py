@@ -8,7 +8,9 @@ call), starting a process by every route (``subprocess``,
 ``_posixsubprocess.fork_exec``, ``os.fork``, ``os.posix_spawn``,
 ``os.system``), writing outside its directory (a ``.pth`` into
 site-packages, the grader's home, ``/tmp``), exhausting memory, forging
-events on the results channel.  Each must score 0.  As root (how the tests
+events on the results channel, forging a result too large to check
+(a 1500-state controller).  Each must score 0.  Attacks on the machine's
+memory, disk and time are in ``tests/test_grading_resources.py``.  As root (how the tests
 run in CI and in a grading container) the child runs as ``nobody`` in its own
 mount namespace, and the report says ``isolation: uid``; a plain user gets
 Landlock and seccomp where the kernel has them.  ``probe.py`` tries every
@@ -38,7 +40,9 @@ LANDLOCK = sys.platform.startswith("linux") and landlock_abi() > 0
 FORGE_LIMIT = 6.0
 MARK = "zz_mutext_hostile_marker"
 
-SUBMISSIONS = {p.stem: p for p in sorted(HOSTILE.glob("ex0*.py"))}
+#: graded in tests/test_grading_resources.py, as root and as a plain user, with the machine checked after
+RESOURCE_ATTACKS = {"ex03_resources"}
+SUBMISSIONS = {p.stem: p for p in sorted(HOSTILE.glob("ex0*.py")) if p.stem not in RESOURCE_ATTACKS}
 EXERCISES = {"ex01": "ex01_two_mass_hinf", "ex03": "ex03_free_decay", "ex04": "ex04_beam_element"}
 
 _pool = ThreadPoolExecutor(max_workers=2)
@@ -142,6 +146,12 @@ def test_forged_events_neither_extend_the_time_limit_nor_pass_values():
     assert "malformed value" in a2.output and a2.score == 0
     if IS_ROOT:
         assert rep.isolation == "uid"     # the forged "confined" event was ignored
+
+
+def test_a_forged_oversize_controller_is_rejected_before_any_computation():
+    rep = graded("ex01_forged_controller")
+    assert "malformed value" in q(rep, "d").output, rep.text()
+    assert rep.seconds < 60, rep.seconds      # the closed loop of 1500 states took the grader 11 minutes
 
 
 # ----------------------------------------------------------------------------

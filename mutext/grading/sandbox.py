@@ -275,17 +275,20 @@ def _read_rules(tree: str, excluded: list) -> tuple:
 
 
 def _safe_rules(paths: list, secret: list, listing: bool = False) -> list:
-    """``paths`` without those whose real path the child may not have: a read rule must lead to a place
-    :func:`_allowed_path` allows (not the package or the grader, not the checkout outside its virtual
-    environment) that holds no secret root; a listing rule (names only) must not lead into a secret root
-    (but the Python installation inside a checkout is fine)."""
+    """``paths`` without those whose real path leads into a secret root (the checkout's own Python
+    installation, a virtual environment in it, excepted) or, for a read rule, holds one (a listing rule
+    reads names only)."""
+    checkout = _real(CHECKOUT) if CHECKOUT is not None else None
+    secret = [_real(s) for s in secret]
     out = []
     for p in paths:
         r = _real(p)
-        if listing:
-            if any(_under(r, s) for s in secret) and not _allowed_path(r):
-                continue
-        elif not _allowed_path(r) or any(_under(s, r) for s in secret):
+        inside = [s for s in secret if _under(r, s)]
+        if any(s != checkout for s in inside):
+            continue
+        if inside and not (any(_under(r, pre) for pre in _prefixes()) or _in_venv(r)):
+            continue
+        if not listing and (r == "/" or any(_under(s, r) for s in secret)):
             continue
         out.append(p)
     return out
