@@ -40,7 +40,7 @@ anything is computed: an array of another shape than asked, e.g. matrices
 far larger than ``2N x 2N``, scores 0 for that call with a message and is
 never factorised.  The errors of (d) are dimensionless: they depend only on
 the support and the mode, not on the drawn beam, so a table of them
-(6 cases x 3 numbers) copied from a working solution would pass (d).
+(5 cases x 3 numbers) copied from a working solution would pass (d).
 
 Feedback names the call by number with its support, number of elements and
 modes (arguments, not answers) and the usual mistakes, never a reference
@@ -575,8 +575,9 @@ def _diagnose_errors(e, ref, length, E, d, rho, support, mode):
                             "(mode numbers start at 1; Python indices at 0)")
             if abs(c - 1) < 1e-2:
                 return (f"your analytic frequency is about {_one_digit(abs(c - 1) * 1e6)} ppm off: use beta L to "
-                        f"at least 10 digits (beta_{mode} L = {bl[mode - 1]:.12g}); with 8 elements the "
-                        "finite-element error is smaller than that")
+                        f"at least 10 digits (beta_{mode} L = {bl[mode - 1]:.12g}); the errors are graded to 0.01 % "
+                        "of themselves, so the analytic value must be far more accurate than the finite-element "
+                        "one with 8 elements")
             nice = _simple_factor(c)
             return ((f"your analytic frequency is {nice} times the exact one" if nice is not None else
                      "your analytic frequency is off by a constant factor")
