@@ -37,8 +37,8 @@ from .errors import ModelError
 __all__ = ["SUMMARY_FIELDS", "check_jobs", "diagnose_batch", "find_data_sets", "run_parallel"]
 
 #: Columns of ``summary.csv``.
-SUMMARY_FIELDS = ("data_set", "status", "diagnosis", "effects", "kind", "station", "element", "value", "unit", "std", "gain",
-                  "error_before", "error_after", "noise", "seconds", "key_kind", "key_station", "key_value",
+SUMMARY_FIELDS = ("data_set", "status", "diagnosis", "effects", "what", "kind", "station", "element", "value",
+                  "unit", "std", "gain", "error_before", "error_after", "noise", "seconds", "key_kind", "key_station", "key_value",
                   "found", "error")
 
 
@@ -75,8 +75,11 @@ def _one(folder: str, out_name: str, mbi: bool) -> dict:
                            mbi=mbi)
             write_diagnosis(res, d / out_name)
         v = res.verdict
-        row.update(diagnosis=res.status, effects="; ".join(f"{e.kind} at {e.station}" for e in res.effects)
-                   or "none", kind=v.kind, station=v.station, element=v.element, value=v.value, unit=v.unit, std=v.std,
+        # the description names the element ("spring k2 (m2-m3) changed", "grounded spring added at m2"):
+        # kind and station alone read alike for different effects
+        row.update(diagnosis=res.status, effects="; ".join(f"{e.description} ({e.size_text(std=False)})"
+                                                           for e in res.effects) or "none",
+                   what=v.description if v.kind != "none" else "none", kind=v.kind, station=v.station, element=v.element, value=v.value, unit=v.unit, std=v.std,
                    gain=res.gain, error_before=res.error_before["rel"], error_after=res.error_after["rel"],
                    noise=res.noise)
     except Exception as exc:      # noqa: BLE001 - one bad data set must not stop the batch
@@ -185,15 +188,14 @@ def _write_summary(root: Path, rows: list, out_name: str):
     (root / "index.html").write_text(
         "<!DOCTYPE html><html><head><meta charset=\"utf-8\"><title>mutext diagnose: batch</title></head><body>"
         f"<h1>Diagnoses under {e(str(root))}</h1>{head}<table border=\"1\" cellpadding=\"3\"><tr><th>data set</th>"
-        "<th>status</th><th>kind</th><th>station</th><th>size</th><th>gain</th><th>right</th><th>error</th></tr>"
+        "<th>status</th><th>diagnosis</th><th>effects</th><th>gain</th><th>right</th><th>error</th></tr>"
         f"{body}</table></body></html>\n", encoding="utf-8")
 
 
 def _row_html(r: dict, root: Path, out_name: str) -> str:
     e = html.escape
     name = e(os.path.relpath(r["data_set"], root))
-    size = "" if r.get("value") is None else f"{r['value']:.4g} {e(r.get('unit', ''))}"
     gain = "" if r.get("gain") is None else f"{r['gain']:.3g}"
     return (f"<tr><td><a href=\"{name}/{e(out_name)}/report.html\">{name}</a></td><td>{e(r['status'])}</td>"
-            f"<td>{e(str(r.get('kind', '')))}</td><td>{e(str(r.get('station', '') or ''))}</td><td>{size}</td>"
+            f"<td>{e(str(r.get('diagnosis', '')))}</td><td>{e(str(r.get('effects', '')))}</td>"
             f"<td>{gain}</td><td>{e(str(r.get('found', '')))}</td><td>{e(r.get('error', ''))}</td></tr>")

@@ -5,8 +5,7 @@ from __future__ import annotations
 import argparse
 import sys
 
-from .errors import MutextError
-from .jsonio import print_json  # noqa: F401  (kept importable from here)
+from .errors import MutextError, UsageError
 
 # name -> (module, one-line description); modules expose add_arguments(parser) and run(args) -> int
 DEMOS = {
@@ -163,10 +162,32 @@ def _cmd_grade(argv) -> int:
     return cli_grade(argv)
 
 
+def __getattr__(name):
+    # ``from mutext.cli import print_json`` keeps working without importing numpy for every command
+    if name == "print_json":
+        from .jsonio import print_json
+        return print_json
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
+
+
+def _version() -> str:
+    from importlib.metadata import PackageNotFoundError, version
+    try:
+        return version("mutext")
+    except PackageNotFoundError:     # a source tree on PYTHONPATH, not installed
+        return "(not installed: source tree)"
+
+
 def main(argv=None) -> int:
     argv = sys.argv[1:] if argv is None else list(argv)
+    if argv[:1] in (["--version"], ["-V"]):
+        print(f"mutext {_version()}")
+        return 0
+    if argv[:1] == ["help"]:
+        # 'mutext help' is the overview, 'mutext help CMD' the command's own help
+        argv = ["--help"] if len(argv) == 1 else [argv[1], "--help"]
     if not argv or argv[0] in ("-h", "--help"):
-        print("usage: mutext {diagnose,rig,frf,demo,check,grade} ...\n\n"
+        print("usage: mutext {diagnose,rig,frf,demo,check,grade,help} ...   (mutext --version)\n\n"
               "  diagnose MODEL.toml DATA.csv [...] [--validate VAL.csv ...] [--out DIR] [--json]\n"
               "                                     what the model gets wrong, why, and the gain once fixed\n"
               "  diagnose --batch DIR [--jobs N]    every data set under DIR, summary.csv and index.html\n"
@@ -189,6 +210,9 @@ def main(argv=None) -> int:
             return _cmd_grade(rest)
         if cmd in COMMANDS:
             return _cmd_module(cmd, rest)
+    except UsageError as exc:
+        print(f"mutext {cmd}: error: {exc}", file=sys.stderr)
+        return 2
     except MutextError as exc:
         print(f"mutext {cmd}: error: {exc}", file=sys.stderr)
         return 1

@@ -24,3 +24,7 @@ class InfeasibleError(MutextError):
 
 class SolverError(MutextError, RuntimeError):
     """A numerical solver failed or returned an inaccurate answer."""
+
+
+class UsageError(MutextError, ValueError):
+    """A command was called wrongly (missing or conflicting arguments); the command line exits with code 2."""

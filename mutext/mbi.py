@@ -188,7 +188,7 @@ def mbi_plant(true, engineering, *, excitation: str, measurement: str, control_i
     for name, v in (("Ww", Ww), ("Wz", Wz)):
         if isinstance(v, bool) or not isinstance(v, (int, float, np.integer, np.floating)) \
                 or not np.isfinite(v) or v <= 0:
-            raise ModelError(f"{name} must be a positive, finite number, got {v!r}")
+            raise ModelError(f"{name} must be positive and finite, got {v!r}")
     if regularization is not None and (
             isinstance(regularization, bool) or not isinstance(regularization, (int, float, np.integer, np.floating))
             or not np.isfinite(regularization) or regularization < 0):
@@ -939,12 +939,14 @@ def identify(true, engineering, *, excitation: str, measurement: str, control_in
                          f"{type(dk_options).__name__}")
     import inspect
 
-    from .dk import dk_iteration
-    known = set(inspect.signature(dk_iteration).parameters) - {"P", "structure", "nmeas", "ncon"}
+    from .dk import dgk_iteration, dk_iteration
+    # the options go to dk_iteration, or to dgk_iteration when real parameters are kept real
+    known = (set(inspect.signature(dk_iteration).parameters) | set(inspect.signature(dgk_iteration).parameters)) \
+        - {"P", "structure", "nmeas", "ncon"}
     unknown = sorted(set(dk_options or {}) - known)
     if unknown:
-        raise ModelError(f"dk_options: unknown option(s) {', '.join(map(repr, unknown))}; dk_iteration takes "
-                         f"{', '.join(sorted(known))}")
+        raise ModelError(f"dk_options: unknown option(s) {', '.join(map(repr, unknown))}; dk_iteration and "
+                         f"dgk_iteration take {', '.join(sorted(known))}")
     opts.update(dk_options or {})
     kw["Wz_shape"] = shape
     search = _search_wz(lambda w: mbi_plant(true, engineering, Wz=w, **kw), Wz, floor, omega, opts, tol,

@@ -17,6 +17,11 @@ from .jsonio import to_json as _to_json
 __all__ = ["write_diagnosis", "to_json", "diagnosis_figures"]
 
 
+
+#: hypotheses shown in the ranking figure and the HTML table (the same ones)
+RANKED = 12
+
+
 def to_json(result: Diagnosis) -> str:
     """The diagnosis as one JSON object (non-finite numbers as strings ``"inf"``, ``"nan"``)."""
     return _to_json(result.as_dict())
@@ -94,7 +99,7 @@ def diagnosis_figures(result, outdir) -> list[str]:
     ax.legend(fontsize=7, ncol=2)
     paths.append(_save(fig, outdir, "residual.png"))
 
-    top = [f for f in result.findings if f.kind != "none"][:10]
+    top = [f for f in result.findings if f.kind != "none"][:RANKED]
     fig, ax = plt.subplots(figsize=(7, 0.35 * len(top) + 1.4))
     labels = [f"{f.kind} @ {f.station} ({f.element})" for f in top][::-1]
     vals = [max(result.misfit_left(f), 1e-3) for f in top][::-1]
@@ -156,7 +161,7 @@ def _html(r: Diagnosis, figs) -> str:
         f"<td>{'' if f.kind == 'none' else f'{f.std:.2g}'}</td><td>{f.delta_chi2:.1f}</td>"
         f"<td>{r.misfit_left(f):.3g}</td>"
         f"<td>{'yes' if f.significant else ('at bound' if f.at_bound else '')}</td></tr>"
-        for k, f in enumerate(r.findings[:15], start=1))
+        for k, f in enumerate([f for f in r.findings if f.kind != "none"][:RANKED], start=1))
     res = "".join(
         f"<tr><td>{e(x.channel)}</td><td>{x.measured_hz:.5g} &plusmn; {x.measured_hz_std:.2g}</td>"
         f"<td>{x.model_hz:.5g}</td><td>{100 * x.freq_error:+.2f} %</td>"
@@ -171,6 +176,9 @@ def _html(r: Diagnosis, figs) -> str:
     notes = "".join(f"<li>{e(n)}</li>" for n in r.notes)
     imgs = "".join(f'<p><img src="{e(f)}" style="max-width:100%"></p>' for f in figs)
     summary = "".join(f"<li>{e(s)}</li>" for s in r.summary)
+    speed_lines = r.at_speed_lines()
+    at_speed = ("<h2>At speed</h2><ul>" + "".join(f"<li>{e(x.strip())}</li>" for x in speed_lines) + "</ul>"
+                if speed_lines else "")
     return f"""<!DOCTYPE html>
 <html><head><meta charset="utf-8"><title>mutext diagnose: {e(r.model_name)}</title>
 <style>body{{font-family:sans-serif;max-width:60em;margin:auto}} td,th{{padding:2px 8px;text-align:right}}
@@ -180,11 +188,12 @@ table{{border-collapse:collapse}} tr:nth-child(even){{background:#f3f3f3}}</styl
 {100 * r.noise:.3g} % (relative).</p>
 <h2>Verdict: {e(r.status)}</h2><p><b>{e(r.headline())}</b></p>{amb}
 {_quality_html(r)}
-<h2>What the model gets wrong</h2><ul>{summary}</ul>
+{at_speed}<h2>What the model gets wrong</h2><ul>{summary}</ul>
 <table><tr><th>channel</th><th>measured Hz</th><th>model Hz</th><th>error</th><th>damping measured</th>
 <th>damping model</th></tr>{res}</table>
 <h2>Hypotheses ({r.n_hypotheses} tested; accepted when delta chi2 &gt; {r.threshold:.1f},
 false-alarm rate {100 * r.alpha:g} %)</h2>
+<p>The {min(RANKED, r.n_hypotheses)} best; "misfit left / noise" is the figure's axis.</p>
 <table><tr><th>rank</th><th>kind</th><th>station</th><th>element</th><th>size</th><th>std</th>
 <th>delta chi2</th><th>misfit left / noise</th><th>significant</th></tr>{rows}</table>
 <h2>Gain on held-out data</h2><p>{e(r.held_out)}</p>

@@ -123,7 +123,7 @@ def test_natural_frequencies_that_overflow_are_named(m, k):
 
 def test_mbi_plant_weights_and_regularization_are_checked():
     from mutext.mbi import mbi_plant
-    for kw, words in (({"Ww": "abc"}, "Ww must be"), ({"Wz": float("nan")}, "Wz must be"),
+    for kw, words in (({"Ww": "abc"}, "Ww must be positive"), ({"Wz": float("nan")}, "Wz must be positive"),
                       ({"regularization": -1.0}, "regularization"), ({"regularization": float("nan")},
                                                                       "regularization")):
         with pytest.raises(ModelError, match=words):
@@ -139,3 +139,10 @@ def test_write_frf_refuses_a_fractional_station(tmp_path):
         write_frf(tmp_path / "a.csv", FRF(f, h, input_station=1, output_station=12.7))
     write_frf(tmp_path / "b.csv", FRF(f, h, input_station=1, output_station=12.0))
     assert read_frf(tmp_path / "b.csv").output_station == 12
+
+
+def test_identify_names_an_unknown_dk_option():
+    from mutext.examples import three_mass as tm
+    from mutext.mbi import identify
+    with pytest.raises(ModelError, match="unknown option.*'bogus'"):
+        identify(**tm.mbi_arguments(tm.TRIALS["1a"]), dk_options={"bogus": 1}, max_tries=1)

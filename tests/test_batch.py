@@ -31,7 +31,16 @@ def test_batch_diagnoses_every_set_and_reports_a_broken_one(cases, capsys):
             assert r["found"] == "True"
             rep = json.loads(open(f"{r['data_set']}/diagnosis/diagnosis.json", encoding="utf-8").read())
             assert rep["verdict"]["kind"] == r["kind"]
-    assert "report.html" in (cases / "index.html").read_text()
+    index = (cases / "index.html").read_text()
+    assert "report.html" in index
+    for r in rows:
+        if r["status"] == "ok":
+            # the effect is named by its element (two kinds at one station read apart), never "none at None"
+            assert " at None" not in r["effects"]
+            if r["kind"] != "none":
+                key = json.loads(open(f"{r['data_set']}/answer_key.json", encoding="utf-8").read())
+                assert r["what"] in r["effects"] and r["what"] != r["kind"], (r, key)
+            assert r["effects"] in index.replace("&#x27;", "'").replace("&quot;", '"')
 
 
 def test_batch_errors_are_named(tmp_path, cases):
@@ -41,7 +50,7 @@ def test_batch_errors_are_named(tmp_path, cases):
         find_data_sets(tmp_path / "nope")
     with pytest.raises(ModelError, match="jobs"):
         diagnose_batch(cases, jobs=0)
-    assert main(["diagnose", "--batch", str(cases), "model.toml"]) == 1
+    assert main(["diagnose", "--batch", str(cases), "model.toml"]) == 2     # a usage error
 
 
 @pytest.mark.slow

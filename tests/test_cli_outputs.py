@@ -30,7 +30,7 @@ def test_rig_hide_refuses_bad_output_dirs(out, words, capsys, tmp_path, monkeypa
 def test_rig_hide_refuses_an_existing_file_and_an_absurd_count(existing_file, capsys, tmp_path):
     assert main(["rig", "hide", "--seed", "1", "--out", str(existing_file)]) == 1
     assert "exists and is not a directory" in _err(capsys)
-    assert main(["rig", "hide", "--seed", "1", "--count", "1000000000", "--out", str(tmp_path / "big")]) == 1
+    assert main(["rig", "hide", "--seed", "1", "--count", "1000000000", "--out", str(tmp_path / "big")]) == 2
     assert "--count must be between 1 and" in _err(capsys)
     assert not (tmp_path / "big").exists()
 
@@ -73,3 +73,27 @@ def test_batch_where_every_data_set_fails_exits_nonzero(tmp_path, capsys):
     out = capsys.readouterr()
     assert code == 1, out
     assert os.path.exists(tmp_path / "batch" / "summary.csv")
+
+
+def test_version_help_and_usage_errors(capsys):
+    from importlib.metadata import version
+    assert main(["--version"]) == 0
+    assert capsys.readouterr().out.strip() == f"mutext {version('mutext')}"
+    assert main(["help"]) == 0 and "usage: mutext" in capsys.readouterr().out
+    with pytest.raises(SystemExit) as exc:          # argparse's own --help
+        main(["help", "diagnose"])
+    assert exc.value.code == 0 and "--validate" in capsys.readouterr().out
+    # usage mistakes exit 2 (as argparse and 'mutext grade' do), errors in the data exit 1
+    assert main(["diagnose"]) == 2 and "give a model file" in _err(capsys)
+    assert main(["diagnose", "m.toml", "d.csv", "--jobs", "2"]) == 2 and "--jobs is for --batch" in _err(capsys)
+    assert main(["diagnose", "--batch", "x", "m.toml"]) == 2 and "--batch takes a directory" in _err(capsys)
+    assert main(["nonsense"]) == 2
+
+
+def test_a_usage_error_is_said_before_the_heavy_imports():
+    import subprocess
+    import sys
+    code = ("import sys; from mutext.cli import main; rc = main(['diagnose']); "
+            "print(rc, 'numpy' in sys.modules, 'casadi' in sys.modules)")
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=120)
+    assert out.stdout.split() == ["2", "False", "False"], out

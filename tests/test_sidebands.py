@@ -95,6 +95,11 @@ def test_diagnose_reports_sidebands_for_data_taken_at_speed():
     assert b["misfit_left"] < 1.5
     assert b["held_out_error"]["rel"] < 0.5 * b["time_invariant_crack"]["held_out_error"]["rel"]
     assert "turns with the shaft" in res.report()
+    # the HTML report says what the terminal says about the data taken at speed
+    from mutext.report import _html
+    page = _html(res, [])
+    assert "<h2>At speed</h2>" in page and "once per revolution" in page
+    assert "crack turning with the shaft" in page
     # a bearing change at speed: no sidebands
     bear = rotor(text=TEXT.replace("stiffness = 1.0e7", "stiffness = 0.8e7", 1))
     res = diagnose(data_path("rotor.toml"), [sweep(bear, seed=6, noise=1e-3)], refit=1,

@@ -29,11 +29,22 @@ def add_arguments(p):
     p.add_argument("--quiet", action="store_true", help="no progress output")
 
 
+def _check_usage(args) -> None:
+    """Usage mistakes, said before anything heavy is imported (exit code 2)."""
+    from ..errors import UsageError
+    if args.batch:
+        if args.model or args.data or args.validate or args.out:
+            raise UsageError("--batch takes a directory only (each data set holds its model and files)")
+        return
+    if args.jobs != 1:
+        raise UsageError("--jobs is for --batch DIR (one diagnosis runs in one process)")
+    if not args.model or not args.data:
+        raise UsageError("give a model file and at least one measured FRF file (or --batch DIR); "
+                         "mutext diagnose --help for the options")
+
+
 def _batch(args, prog) -> int:
     from ..batch import diagnose_batch
-    from ..errors import ModelError
-    if args.model or args.data or args.validate or args.out:
-        raise ModelError("--batch takes a directory only (each data set holds its model and files)")
     rows = diagnose_batch(args.batch, jobs=args.jobs, mbi=args.mbi, progress=prog)
     if args.json:
         import json
@@ -55,6 +66,7 @@ def _batch(args, prog) -> int:
 
 
 def run(args) -> int:
+    _check_usage(args)
     from ..diagnose import diagnose
     from ..errors import ModelError
     from ..progress import ProgressLine
@@ -63,8 +75,6 @@ def run(args) -> int:
     prog = ProgressLine(enabled=not args.quiet)
     if args.batch:
         return _batch(args, prog)
-    if not args.model or not args.data:
-        raise ModelError("give a model file and at least one measured FRF file (or --batch DIR)")
     # read_frfs: a Universal File may hold several FRFs (data sets 58), all used
     if args.out is not None:
         from .._files import output_directory

@@ -129,7 +129,7 @@ def _format(path, role) -> str:
 
 
 def _mapping(items):
-    from ..errors import ModelError
+    from ..errors import ModelError, UsageError
     if items is None:
         return None
     out = {}
@@ -140,19 +140,19 @@ def _mapping(items):
                 raise ValueError
             out[int(node)] = int(station)
         except ValueError:
-            raise ModelError(f"--map: {it!r} is not NODE=STATION (two integers, e.g. 101=3)") from None
+            raise UsageError(f"--map: {it!r} is not NODE=STATION (two integers, e.g. 101=3)") from None
     return out
 
 
 def _units(items):
-    from ..errors import ModelError
+    from ..errors import ModelError, UsageError
     if items is None:
         return None
     out = {}
     for it in items:
         label, sep, unit = it.rpartition("=")
         if not sep or not label.strip() or not unit.strip():
-            raise ModelError(f"--units: {it!r} is not LABEL=UNIT (e.g. 'EU/lbf=g/lbf')")
+            raise UsageError(f"--units: {it!r} is not LABEL=UNIT (e.g. 'EU/lbf=g/lbf')")
         out[label.strip()] = unit.strip()
     return out
 
@@ -187,16 +187,16 @@ def convert(inputs, output, *, ordinate=None, binary=False, unit=None, mapping=N
     header entries UFF cannot hold).  ``units``: labels to read differently
     (:func:`mutext.uff.read_uff58`).
     """
-    from ..errors import ModelError
+    from ..errors import ModelError, UsageError
     from ..rig import FRFFileError, read_frfs, write_frf
     from ..uff import write_uff58
     notes = [] if notes is None else notes
     out_fmt = _format(output, "output")
     if out_fmt == "csv" and (ordinate is not None or binary):
-        raise ModelError(f"{output}: --ordinate and --binary are for a Universal File output (.uff, .unv); a CSV "
+        raise UsageError(f"{output}: --ordinate and --binary are for a Universal File output (.uff, .unv); a CSV "
                          f"file holds displacement per force or current")
     if out_fmt == "uff" and unit is not None:
-        raise ModelError(f"{output}: --unit is for a CSV output; a Universal File written by mutext is in SI")
+        raise UsageError(f"{output}: --unit is for a CSV output; a Universal File written by mutext is in SI")
     for p in inputs:
         _format(p, "input")
         if not Path(p).exists():

@@ -27,11 +27,11 @@ def add_arguments(p):
 
 def run(args) -> int:
     import os
-    from ..errors import ModelError
+    from ..errors import ModelError, UsageError
     from ..hide import hidden_effect_data
     from .._files import output_directory
     if args.count < 1 or args.count > MAX_COUNT:
-        raise ModelError(f"--count must be between 1 and {MAX_COUNT} (data sets of one call), got {args.count}")
+        raise UsageError(f"--count must be between 1 and {MAX_COUNT} (data sets of one call), got {args.count}")
     output_directory(args.out)
     if args.count > 1:
         for seed in range(args.seed, args.seed + args.count):

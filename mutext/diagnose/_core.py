@@ -154,7 +154,7 @@ def _diagnose(model, frfs, validate, alpha, refit, noise, out_dir, progress, onl
         _judge(f, N, threshold)
     for f in findings[:5]:
         if f.at_bound:
-            notes.append(f"{f.description} fits best at the bound of its range ({f.value:.4g} {f.unit}): "
+            notes.append(f"{f.description} fits best at the bound of its range ({f.size_text(std=False)}): "
                          "not accepted (the data ask for more than the hypothesis allows)")
     none = Finding("none", None, None, 0.0, "", 0.0, rss0 / s2, 0.0, "no effect beyond the noise")
     findings.sort(key=lambda f: f.score)

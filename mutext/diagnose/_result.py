@@ -244,6 +244,34 @@ class Diagnosis:
         none = next(f for f in self.findings if f.kind == "none")
         return (none.score - finding.delta_chi2) / max(self.n_residuals, 1)
 
+    def at_speed_lines(self) -> list:
+        """What the data taken at speed say: the sideband verdict and a crack turning with the shaft (rotors;
+        empty otherwise).  The text report and the HTML report both print these lines."""
+        out = []
+        if self.sidebands:
+            sb = self.sidebands
+            found = [c for c in sb["candidates"] if c["found"]]
+            out.append(f"sidebands (data taken at {sb['speed_hz']:.4g} Hz): {sb['verdict']}: {sb['meaning']}"
+                       + ("" if not found else "; at " + ", ".join(
+                           f"{c['freq_hz']:.1f} Hz (k={c['k']:+d})" for c in found[:6])))
+        if self.breathing:
+            b = self.breathing
+            ti = b["time_invariant_crack"]
+            line = (("NOT SUPPORTED (" + b["rejected"] + "): " if b.get("rejected") else "")
+                    + f"crack turning with the shaft ({b['law']} breathing) in the {b['element']}: a/D = "
+                    f"{b['depth_ratio']:.4g} +/- {b['depth_std']:.2g} (time-invariant crack there: "
+                    f"a/D {ti['depth_ratio']:.4g}); misfit left {b['misfit_left']:.3g}")
+            if b["delta_chi2_vs_time_invariant"] is not None:
+                line += f", delta chi2 {b['delta_chi2_vs_time_invariant']:.1f} over the time-invariant crack"
+            out.append(line)
+            he = b["held_out_error"]
+            tie = ti.get("held_out_error")
+            out.append(f"  held-out: {100 * he['rel']:.3g} % rms complex error"
+                       + ("" if not tie else f" (time-invariant crack: {100 * tie['rel']:.3g} %)")
+                       + f"; projection error of the reduced rotor {b['projection_error']:.1g}; {b['seconds']:.0f} s")
+            out.append("  add to the model file: " + b["model_addition"].strip().replace("\n", "; "))
+        return out
+
     def report(self) -> str:
         """Plain-text report (what the command prints)."""
         nr = self.noise_reference
@@ -326,28 +354,7 @@ class Diagnosis:
                            f"diagnosis {m['diagnosis_value']:+.4g}: "
                            + ("they agree" if m["agrees"] else "they DISAGREE (beyond 3 standard uncertainties)")
                            + f" (mu {m['mu']:.3f}, {m['seconds']:.0f} s)")
-        if self.sidebands:
-            sb = self.sidebands
-            found = [c for c in sb["candidates"] if c["found"]]
-            out.append(f"sidebands (data taken at {sb['speed_hz']:.4g} Hz): {sb['verdict']}: {sb['meaning']}"
-                       + ("" if not found else "; at " + ", ".join(
-                           f"{c['freq_hz']:.1f} Hz (k={c['k']:+d})" for c in found[:6])))
-        if self.breathing:
-            b = self.breathing
-            ti = b["time_invariant_crack"]
-            line = (("NOT SUPPORTED (" + b["rejected"] + "): " if b.get("rejected") else "")
-                    + f"crack turning with the shaft ({b['law']} breathing) in the {b['element']}: a/D = "
-                    f"{b['depth_ratio']:.4g} +/- {b['depth_std']:.2g} (time-invariant crack there: "
-                    f"a/D {ti['depth_ratio']:.4g}); misfit left {b['misfit_left']:.3g}")
-            if b["delta_chi2_vs_time_invariant"] is not None:
-                line += f", delta chi2 {b['delta_chi2_vs_time_invariant']:.1f} over the time-invariant crack"
-            out.append(line)
-            he = b["held_out_error"]
-            tie = ti.get("held_out_error")
-            out.append(f"  held-out: {100 * he['rel']:.3g} % rms complex error"
-                       + ("" if not tie else f" (time-invariant crack: {100 * tie['rel']:.3g} %)")
-                       + f"; projection error of the reduced rotor {b['projection_error']:.1g}; {b['seconds']:.0f} s")
-            out.append("  add to the model file: " + b["model_addition"].strip().replace("\n", "; "))
+        out += self.at_speed_lines()
         if self.extended_model:
             out.append(f"extended model: {self.extended_model}" + ("" if self.confirmed else
                        " (NOT a confirmed fix: written under a name that says so)"))
