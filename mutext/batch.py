@@ -24,6 +24,7 @@ match it (the Monte Carlo success rate of ``benchmarks/bench_diagnose.py``).
 """
 from __future__ import annotations
 
+import contextlib
 import csv
 import html
 import json
@@ -34,7 +35,7 @@ from pathlib import Path
 
 from .errors import ModelError
 
-__all__ = ["SUMMARY_FIELDS", "check_jobs", "diagnose_batch", "find_data_sets", "run_parallel"]
+__all__ = ["SUMMARY_FIELDS", "check_jobs", "dask_backend", "diagnose_batch", "find_data_sets", "run_parallel"]
 
 #: Columns of ``summary.csv``.
 SUMMARY_FIELDS = ("data_set", "status", "diagnosis", "effects", "what", "kind", "station", "element", "value",
@@ -137,6 +138,51 @@ def run_parallel(fn, tasks, *, jobs: int = 1, progress=None, describe=None):
         if progress is not None:
             progress(describe(k, n, out) if describe is not None else f"case {k}/{n}", k / n)
         yield out
+
+
+@contextlib.contextmanager
+def dask_backend(scheduler: str, workers: int = -1):
+    """Run the batches inside the block on a Dask cluster, through joblib's Dask backend.
+
+    ``scheduler`` is the address of a running scheduler (``tcp://host:8786``;
+    start one with ``dask scheduler`` and workers with ``dask worker ADDRESS``)
+    or ``"local"`` for a cluster of ``workers`` processes on this machine
+    (one thread each; ``-1``: one per core).  Yields a line saying where the
+    work runs.  Every worker needs mutext installed (the same version).
+
+    Raises
+    ------
+    ModelError
+        ``dask.distributed`` is not installed, or the scheduler cannot be reached.
+    """
+    try:
+        import joblib
+        from distributed import Client, LocalCluster
+    except ImportError:
+        raise ModelError("--scheduler needs Dask's distributed scheduler: pip install -e '.[cluster]' "
+                         "(or pip install 'dask[distributed]')") from None
+    cluster = None
+    try:
+        if scheduler == "local":
+            n = (os.cpu_count() or 1) if workers in (None, -1) else check_jobs(workers)
+            cluster = LocalCluster(n_workers=max(1, n), threads_per_worker=1, processes=True,
+                                   dashboard_address=None)
+            client = Client(cluster)
+        else:
+            client = Client(scheduler, timeout="10s")
+    except (OSError, TimeoutError) as exc:
+        if cluster is not None:
+            cluster.close()
+        raise ModelError(f"--scheduler {scheduler}: cannot reach the Dask scheduler ({exc})") from None
+    try:
+        n_workers = len(client.scheduler_info().get("workers", {}))
+        where = f"scheduler {client.scheduler.address}, {n_workers} worker(s)"
+        with joblib.parallel_backend("dask"):
+            yield where
+    finally:
+        client.close()
+        if cluster is not None:
+            cluster.close()
 
 
 def diagnose_batch(root, *, jobs: int = 1, out_name: str = "diagnosis", mbi: bool = False,

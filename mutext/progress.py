@@ -20,6 +20,7 @@ class ProgressLine:
         self.tty = hasattr(self.stream, "isatty") and self.stream.isatty()
         self.t0 = time.perf_counter()
         self.last = None
+        self.last_tenth = -1
         self.bar_shown = False      # an unfinished bar is on the terminal's current line
 
     def write(self, text: str):
@@ -44,9 +45,12 @@ class ProgressLine:
             if fraction >= 1.0:
                 self.stream.write("\n")
         else:
+            # a log, not a bar: a line when the stage changes, at every further tenth of the work, and at the end
+            # (one line per stage alone jumped from the first case of a batch to 100 %)
             head = stage.split(" ")[0]
-            if head == self.last and fraction < 1.0:
+            tenth = int(10 * fraction + 1e-9)
+            if head == self.last and tenth <= self.last_tenth and fraction < 1.0:
                 return
-            self.last = head
+            self.last, self.last_tenth = head, tenth
             self.stream.write(line + "\n")
         self.stream.flush()

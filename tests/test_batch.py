@@ -63,3 +63,30 @@ def test_batch_runs_on_a_local_dask_cluster(tmp_path):
             rows = diagnose_batch(tmp_path, jobs=-1)
     assert [r["status"] for r in rows] == ["ok"] * 3
     assert all(r["found"] for r in rows)
+
+
+@pytest.mark.slow
+def test_batch_on_a_running_dask_scheduler_from_the_command_line(tmp_path, capsys):
+    distributed = pytest.importorskip("distributed")
+    assert main(["rig", "hide", "--seed", "30", "--count", "2", "--out", str(tmp_path)]) == 0
+    with distributed.LocalCluster(n_workers=2, threads_per_worker=1, processes=True, host="127.0.0.1",
+                                  dashboard_address=None) as cluster:
+        address = cluster.scheduler_address
+        assert address.startswith("tcp://127.0.0.1:")
+        capsys.readouterr()
+        assert main(["diagnose", "--batch", str(tmp_path), "--scheduler", address]) == 0
+    out = capsys.readouterr()
+    assert f"Dask: scheduler {address}, 2 worker(s)" in out.err
+    rows = list(csv.DictReader(open(tmp_path / "summary.csv", encoding="utf-8")))
+    assert [r["status"] for r in rows] == ["ok", "ok"] and all(r["found"] == "True" for r in rows)
+
+
+def test_scheduler_errors_are_named(tmp_path, capsys):
+    # a usage mistake, and a scheduler that cannot be reached (or Dask not installed): named, no traceback
+    assert main(["diagnose", "m.toml", "d.csv", "--scheduler", "local"]) == 2
+    assert "--scheduler are for --batch" in capsys.readouterr().err
+    assert main(["rig", "hide", "--seed", "31", "--out", str(tmp_path / "c")]) == 0
+    capsys.readouterr()
+    assert main(["diagnose", "--batch", str(tmp_path), "--scheduler", "tcp://127.0.0.1:9", "--quiet"]) == 1
+    err = capsys.readouterr().err
+    assert ("cannot reach the Dask scheduler" in err or "needs Dask's distributed" in err) and "Traceback" not in err

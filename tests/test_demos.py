@@ -58,3 +58,16 @@ def test_progress_line_is_also_the_log_stream_below_the_bar():
     term.text = ""
     print("after the end", file=line)               # a finished bar stays
     assert term.text == "after the end\n"
+
+
+def test_progress_piped_into_a_log_shows_every_tenth():
+    import io
+
+    from mutext.progress import ProgressLine
+    log = io.StringIO()                    # not a terminal: one line per step worth saying
+    line = ProgressLine(log)
+    for k in range(1, 31):
+        line(f"data set {k}/30: case_{k} ok", k / 30)
+    pct = [int(x.split("]")[1].split("%")[0]) for x in log.getvalue().splitlines()]
+    assert pct[0] == 3 and pct[-1] == 100 and len(pct) == 11
+    assert all(b - a <= 10 for a, b in zip(pct, pct[1:]))      # no jump from the first case to the end

@@ -26,6 +26,10 @@ def add_arguments(p):
                                                   "measured/, as 'mutext rig hide' writes); reports beside the data, "
                                                   "summary.csv and index.html in DIR")
     p.add_argument("--jobs", type=int, default=1, help="parallel workers for --batch (-1: all cores)")
+    p.add_argument("--scheduler", metavar="ADDRESS", default=None,
+                   help="for --batch: run the data sets on a Dask cluster: the address of a running scheduler "
+                        "(tcp://host:8786), or 'local' for a cluster of --jobs worker processes on this machine "
+                        "(needs pip install -e '.[cluster]')")
     p.add_argument("--quiet", action="store_true", help="no progress output")
 
 
@@ -36,8 +40,8 @@ def _check_usage(args) -> None:
         if args.model or args.data or args.validate or args.out:
             raise UsageError("--batch takes a directory only (each data set holds its model and files)")
         return
-    if args.jobs != 1:
-        raise UsageError("--jobs is for --batch DIR (one diagnosis runs in one process)")
+    if args.jobs != 1 or args.scheduler:
+        raise UsageError("--jobs and --scheduler are for --batch DIR (one diagnosis runs in one process)")
     if not args.model or not args.data:
         raise UsageError("give a model file and at least one measured FRF file (or --batch DIR); "
                          "mutext diagnose --help for the options")
@@ -45,7 +49,13 @@ def _check_usage(args) -> None:
 
 def _batch(args, prog) -> int:
     from ..batch import diagnose_batch
-    rows = diagnose_batch(args.batch, jobs=args.jobs, mbi=args.mbi, progress=prog)
+    if args.scheduler:
+        from ..batch import dask_backend
+        with dask_backend(args.scheduler, workers=args.jobs) as where:
+            prog(f"Dask: {where}", 0.0)
+            rows = diagnose_batch(args.batch, jobs=-1, mbi=args.mbi, progress=prog)
+    else:
+        rows = diagnose_batch(args.batch, jobs=args.jobs, mbi=args.mbi, progress=prog)
     if args.json:
         import json
         print(json.dumps(rows, default=str))
