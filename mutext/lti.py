@@ -60,7 +60,10 @@ def ss(A, B, C, D, *, inputs=None, outputs=None, states=None, name=None) -> ct.S
     _check_real(A, B, C, D, what=what)
     mats = []
     for label, X in zip("ABCD", (A, B, C, D)):
-        arr = np.asarray(X) if not isinstance(X, np.ndarray) else X
+        try:
+            arr = np.asarray(X) if not isinstance(X, np.ndarray) else X
+        except (TypeError, ValueError):
+            raise ModelError(f"{what}.{label} is not a matrix (rows of unequal length?): {X!r}"[:300]) from None
         if arr.size and (arr.dtype == object or arr.dtype.kind in "USV"):
             numbers = (int, float, np.integer, np.floating)
             odd = [v for v in np.ravel(arr) if not isinstance(v, numbers)][:1]

@@ -509,6 +509,92 @@ def _prop_demo_rotor():
 
 
 # ----------------------------------------------------------------------------
+# state-space construction, norms at extreme scales, frequency grids, block structures
+# ----------------------------------------------------------------------------
+
+SHAPES = st.tuples(st.integers(0, 3), st.integers(0, 3))
+ENTRY = st.one_of(EXTREME, st.sampled_from([None, "a", True, 1 + 2j]))
+
+
+@st.composite
+def matrix_like(draw):
+    kind = draw(st.sampled_from(["2d", "2d", "1d", "scalar", "3d", "ragged"]))
+    if kind == "scalar":
+        return draw(ENTRY)
+    if kind == "1d":
+        return draw(st.lists(ENTRY, max_size=4))
+    if kind == "ragged":
+        return [draw(st.lists(ENTRY, max_size=3)) for _ in range(draw(st.integers(1, 3)))]
+    r, c = draw(SHAPES)
+    rows = [[draw(ENTRY) for _ in range(c)] for _ in range(r)]
+    return [rows, rows] if kind == "3d" else rows
+
+
+def _prop_ss():
+    from mutext.lti import ss
+
+    @given(matrix_like(), matrix_like(), matrix_like(), matrix_like())
+    def prop(A, B, C, D):
+        G = call("ss", ss, A, B, C, D, seconds=10)
+        if G is not None:
+            n, m, p = G.nstates, G.ninputs, G.noutputs
+            assert G.A.shape == (n, n) and G.B.shape == (n, m) and G.C.shape == (p, n) and G.D.shape == (p, m)
+    return prop
+
+
+def _prop_hinf_norm_scaling():
+    from mutext.lti import hinf_norm, ss
+
+    base = ss([[-1.0, 3.0], [-3.0, -1.0]], [[1.0], [0.5]], [[1.0, -0.2]], [[0.1]])
+    ref = hinf_norm(base).value
+
+    @given(st.integers(-150, 150), st.integers(-150, 150), st.one_of(st.floats(1e-14, 0.5), EXTREME))
+    def prop(kb, kc, rtol):
+        b, c = 10.0 ** kb, 10.0 ** kc
+        G = ss(base.A, base.B * b, base.C * c, base.D * b * c)
+        r = call("hinf_norm scaled", hinf_norm, G, rtol=rtol, seconds=20)
+        if r is not None:
+            # the norm of b c G is |b c| ||G||: exact rescaling, inf only beyond the largest double
+            want = ref * b * c
+            if np.isfinite(want) and want > 1e-290:
+                # within the bracket asked for (rtol), and never above the certified upper level
+                assert r.value == pytest.approx(want, rel=max(1e-6, 2 * float(rtol)))
+                assert r.value <= want * (1 + 1e-9) <= r.upper * (1 + 1e-6)
+            elif not np.isfinite(want):
+                assert r.value == np.inf
+    return prop
+
+
+def _prop_freqresp():
+    from mutext.lti import freqresp, ss
+
+    G = ss([[-0.1, 2.0], [-2.0, -0.1]], [[0.0], [1.0]], [[1.0, 0.0]], [[0.0]])
+
+    @given(st.one_of(arrays(0, 8), st.lists(st.lists(FINITE, min_size=2, max_size=2), max_size=3),
+                     st.sampled_from(["abc", None, [[]], 1.0])))
+    def prop(omega):
+        H = call("freqresp", freqresp, G, omega, seconds=10)
+        if H is not None:
+            assert H.shape[:2] == (1, 1) and np.all(np.isfinite(H))
+    return prop
+
+
+def _prop_block_spec():
+    from mutext.mu import BlockStructure
+
+    @given(st.one_of(st.lists(st.lists(st.one_of(st.integers(-4, 4), st.floats(-3, 3), st.just(None)),
+                                       max_size=3), max_size=4),
+                     st.sampled_from([None, 5, "abc", [[1, 2, 3]]])))
+    def prop(spec):
+        b = call("BlockStructure.from_spec", BlockStructure.from_spec, spec, seconds=10)
+        if b is not None:
+            assert len(b) == len(spec)
+            for blk, (r, c) in zip(b, spec):
+                assert blk.rows == abs(int(r)) and (blk.cols == int(c) if c else True)
+    return prop
+
+
+# ----------------------------------------------------------------------------
 # the tests: (factory, default examples, slow examples)
 # ----------------------------------------------------------------------------
 
@@ -525,6 +611,10 @@ PROPS = {
     "fit_impedance": (_prop_fit_impedance, 40, 400),
     "rotor": (_prop_rotor, 6, 60),
     "demo_rotor": (_prop_demo_rotor, 3, 20),
+    "ss": (_prop_ss, 60, 600),
+    "hinf_norm_scaling": (_prop_hinf_norm_scaling, 30, 300),
+    "freqresp": (_prop_freqresp, 30, 300),
+    "block_spec": (_prop_block_spec, 40, 400),
 }
 
 
