@@ -1,8 +1,9 @@
 r"""A breathing crack fitted to data taken at speed (after the sidebands say the rotor is time-periodic).
 
-The time-invariant hypotheses of the screen can place a crack but can only
-fit its stiffness averaged over a revolution, and they leave the sidebands
-unexplained.  When the sideband evidence says the stiffness changes with
+The time-invariant hypotheses of the screen can place a crack but fit it as
+a crack held still, its normal facing :math:`x` (not turning with the shaft,
+and not its stiffness averaged over a revolution either: the two read
+different depths), and they leave the sidebands unexplained.  When the sideband evidence says the stiffness changes with
 the rotation, this step fits the depth :math:`a/D` of a crack that turns with
 the shaft (breathing law ``mayes`` or ``gasch`` for once-per-revolution
 sidebands, ``open`` for twice-per-revolution ones) at the crack station the

@@ -322,7 +322,8 @@ def _sideband_claim(result) -> None:
         return
     result.notes.append(f"the data show sidebands ({sb['verdict']}): the rotor is time-periodic, which no "
                         f"time-invariant hypothesis above can hold; {sb['meaning']}"
-                        + (". The crack finding describes its stiffness averaged over a revolution"
+                        + (". The crack finding is a crack held still facing x (time-invariant), not one "
+                           "turning with the shaft"
                            if result.verdict.kind == "crack" else ""))
 
 
