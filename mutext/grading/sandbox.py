@@ -578,6 +578,24 @@ class _Scratch:
         self.shared = uid is not None and os.name == "posix"
         self.before = {d: self._names(d) for d in self.SHARED} if self.shared else {}
         self.failures = 0
+        self.others = self._others(None) if self.shared else False   # processes of the user besides ours
+        self.left = []
+
+    def _others(self, pid):
+        """Does any process of the child's user run besides ``pid``?  (Then what that user created in the
+        shared directories may not be the child's, and is not removed.)"""
+        try:
+            names = os.listdir("/proc")
+        except OSError:
+            return True
+        for n in names:
+            if n.isdigit() and int(n) != pid:
+                try:
+                    if os.stat(f"/proc/{n}").st_uid == self.uid:
+                        return True
+                except OSError:
+                    pass
+        return False
 
     @staticmethod
     def _names(d):
@@ -604,6 +622,8 @@ class _Scratch:
         try:
             seen = set()
             used, files = _tree_use(self.box, SCRATCH_BYTES, SCRATCH_FILES, seen)
+            if self.shared and not self.others:
+                self.others = self._others(pid)
             for p in (self.strays() if self.shared else []):
                 if os.path.isdir(p) and not os.path.islink(p):
                     b, f = _tree_use(p, SCRATCH_BYTES - used, SCRATCH_FILES - files, seen)
@@ -624,9 +644,15 @@ class _Scratch:
         return None
 
     def clean(self, keep=("submission.py",)):
-        """Empty the scratch directory (but ``keep``) and remove what the child left in shared places."""
+        """Empty the scratch directory (but ``keep``) and remove what the child left in shared places
+        (only when no other process of its user ran meanwhile; otherwise :attr:`left` lists it)."""
         ok = _remove_tree(self.box, keep=keep)
-        for p in (self.strays() if self.shared else []):
+        strays = self.strays() if self.shared else []
+        if strays and (self.others or self._others(None)):
+            self.others = True
+            self.left = sorted(set(self.left + strays))
+            return False
+        for p in strays:
             ok = _remove_tree(p) and ok
         return ok
 
@@ -782,17 +808,24 @@ def _clean_calls(kind, calls, n):
     return out
 
 
-def _confinement(ev, mode):
-    """``(isolation, details)`` from the child's ``confined`` event."""
+def _confinement(ev, mode, batch=()):
+    """``(isolation, details)`` from the child's ``confined`` event (``batch``: the submission's original
+    file and its batch-mates, which the child's probe tried to read too)."""
     applied = [str(a) for a in ev.get("applied") or []][:20]
     problems = [str(a)[:300] for a in ev.get("problems") or []][:20]
-    readable = [str(a) for a in ev.get("readable") or []][:10]
+    found = [str(a) for a in ev.get("readable") or []][:200]
+    readable = [a for a in found if a not in batch][:10]
+    mates = [a for a in found if a in batch][:5]
     writable = [str(a) for a in ev.get("writable") or []][:10]
     details = applied + problems
     tmp = _real(tempfile.gettempdir())
     critical = [w for w in writable if w != tmp]
     if readable:
         details.append("the submission could read " + ", ".join(readable))
+    if mates:
+        details.append("the submission could read the files of its directory (its own original, other "
+                       "submissions): " + ", ".join(mates))
+        readable += mates
     if writable:
         details.append("the submission could write into " + ", ".join(writable))
     if readable or critical:
@@ -851,7 +884,7 @@ def _run_once(workdir, plan, jobs, time_limit, outcomes, imp, log, state, scratc
             now = time.monotonic()
             if kind == "confined" and stage == "startup":
                 stage = "confined"
-                state["isolation"], state["details"] = _confinement(ev, plan["mode"])
+                state["isolation"], state["details"] = _confinement(ev, plan["mode"], plan["probe_batch"])
                 applied = [str(a) for a in ev.get("applied") or []]
                 if scratch is not None and any(a == "mount-namespace" or a.startswith("landlock") for a in applied):
                     scratch.shared = False      # the child could not write into the shared directories
@@ -960,6 +993,7 @@ def _prepare(workdir: Path, submission, extra_modules) -> dict:
         "read": full, "list": listing, "write": [str(box), "/dev/null"],
         "python_dirs": python, "extra_paths": _extra_paths(),
         "probe_read": _probe_files(extra_modules, submission), "probe_write": _probe_dirs(workdir),
+        "probe_batch": _batch_files(submission),
         "rlimits": {"as": MEMORY_LIMIT, "fsize": FILE_SIZE_LIMIT, "core": 0, "nofile": 1024,
                     **({"nproc": PROCESS_LIMIT} if mode == "root" else {})},
         # the audit hook's lists (reports attempts; the confinement is what blocks them)
@@ -1089,9 +1123,15 @@ def run_submission(submission, jobs, time_limit: float = 60.0, blocked_modules=(
                 if isinstance(c, dict) and "error" in c:
                     c["error"] = rename(c["error"])
         tail = rename("\n".join(s for s in log if s.strip())[-2000:])
+        details = state.get("details", ["the child did not report its confinement"])
+        if scratch.shared:
+            scratch.clean()
+            scratch.shared = False
+            if scratch.left:
+                details.append("not removed (other processes of the unprivileged user ran): what it created "
+                               "in the shared temporary directories: " + ", ".join(scratch.left[:10]))
         return SandboxResult(import_=imp, questions=outcomes, children=children, stderr_tail=tail,
-                             isolation=state.get("isolation", "none"),
-                             isolation_details=state.get("details", ["the child did not report its confinement"]))
+                             isolation=state.get("isolation", "none"), isolation_details=details)
     finally:
         if scratch is not None and scratch.shared:
             scratch.clean()
