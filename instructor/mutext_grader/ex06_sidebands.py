@@ -23,7 +23,7 @@ Inputs are drawn from the generator the grader is given (:mod:`mutext_grader.cor
 the running speed (9, 10 or 11 Hz), the depths of the cracks and the stiffness
 of the softer bearings (:data:`CHOICES`), the model behind each sweep of (c)
 with the number of each verdict (1 to 3 "none", at least 2 of each crack),
-every sweep's noise level (0.5-1e-3 for (c), drawn alike whatever the model,
+every sweep's noise level (5e-4 to 1e-3 in (c), drawn alike whatever the model,
 so the noise argument says nothing of the verdict) and noise, the sidebands
 and frequencies of (a) and (b).  A noisy sweep is kept only when the recipe
 of the exercise's docstring classifies it as its model (and, in (b), when the
