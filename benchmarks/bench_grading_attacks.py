@@ -35,6 +35,9 @@ HONEST = {"destabilizing", "missing_noise", "wrong_weight", "one_exception", "wr
           "ex04_hz_and_pi", "ex04_lumped_mass", "ex04_missing_L", "ex04_no_supports", "ex05_hz_as_rad",
           "ex05_never_none", "ex05_unwrapped_phase", "ex05_zero_based", "ex06_centre_in_fit",
           "ex06_fixed_threshold", "ex06_rad_per_s"}
+#: files that cheat on one question and answer the others honestly (their points come from those; the
+#: tests check that the cheated question scores 0)
+PART_CHEAT = {"cheat_in_functions", "ex02_cheat_mu", "ex04_cheat_rotor"}
 #: not submissions (helpers of the tests)
 SKIP = {"probe", "reader"}
 
@@ -55,7 +58,7 @@ def _cases():
             if group == "cheat" and p.stem in ("syntax_error", "infinite_loop"):
                 group_ = "broken"
             elif group == "cheat":
-                group_ = "partial" if p.stem in HONEST else "cheat"
+                group_ = "partial" if p.stem in HONEST else ("cheat+" if p.stem in PART_CHEAT else "cheat")
             else:
                 group_ = group
             out.append((group_, p.stem, p))
@@ -124,7 +127,7 @@ def main(argv=None) -> int:
             print(f"{group:<9} {name:<28} {_exercise(name):<5} {mode:<5} {score:>5.2f}/{mx:<5g} {iso:<9} "
                   f"{dt:6.1f} {litter:>6d} {dshm:>+8.1f}{flag}", flush=True)
     sandbox.FORCE_MODE = None
-    bad = [r for r in rows if r[0] not in ("reference", "partial") and r[3] > 0]
+    bad = [r for r in rows if r[0] not in ("reference", "partial", "cheat+") and r[3] > 0]
     refs = [r for r in rows if r[0] == "reference"]
     print(f"\n{len(rows)} gradings; submissions that do not solve and scored above 0: {len(bad)}; "
           f"references at full marks: {sum(r[3] == r[4] for r in refs)}/{len(refs)}; "
