@@ -122,6 +122,8 @@ def _diagnose(model, frfs, validate, alpha, refit, noise, out_dir, progress, onl
         if progress is not None:
             progress(stage, frac)
 
+    # a rotor's model is built (symbolic finite elements) while the files are read: seconds to tens of seconds
+    tell("reading the model file and the data (a rotor's finite elements are built here)", 0.0)
     path, eng, model_text, chans, vchans, speed, input_notes = _inputs(model, frfs, validate, alpha)
     tell("noise level of the data (model-free rational fits)", 0.01)
     ref = noise_reference(chans, _noise(noise))
