@@ -7,10 +7,10 @@ Usage (as root, from the repository root; several minutes)::
 
 Course mode: ``--require-isolation`` and a course secret, as the Gradescope scripts run it.  For each
 submission the table prints the exercise, the mode, the score, the isolation that was enforced, the
-seconds, and what changed on the machine: new entries in /tmp, /var/tmp and /dev/shm that the grading
-made (names beginning with ``mutext`` or owned by ``nobody``), and the change of shared memory
-(``Shmem`` in /proc/meminfo).  Other processes on the machine can make the last two columns noisy:
-run it on a quiet machine.  A row whose score is above 0 for a submission that does not solve the
+seconds, and what changed on the machine while it ran: new entries in /tmp, /var/tmp and /dev/shm
+(names beginning with ``mutext`` or owned by ``nobody``), and the change of shared memory (``Shmem`` in
+/proc/meminfo).  Other processes on the machine (a test run making its own ``mutext-*`` directories)
+count in those two columns too; the last line lists what is still there after all gradings.  A row whose score is above 0 for a submission that does not solve the
 exercise is marked ``<-``.
 """
 from __future__ import annotations
@@ -30,7 +30,7 @@ SUBS = ROOT / "tests" / "grading_submissions"
 SOLUTIONS = ROOT / "instructor" / "mutext_grader" / "solutions"
 SHARED = ("/tmp", "/var/tmp", "/dev/shm")
 #: submissions that are meant to score points (partly right answers; graded for the table, not marked)
-HONEST = {"destabilizing", "missing_noise", "wrong_weight", "one_exception", "wrong_types", "ex02_crude",
+HONEST = {"infinite_loop", "destabilizing", "missing_noise", "wrong_weight", "one_exception", "wrong_types", "ex02_crude",
           "ex02_dmd_sign", "ex02_spectral_radius", "ex03_decrement_not_per_cycle", "ex03_hz", "ex03_thesis_eq33",
           "ex04_hz_and_pi", "ex04_lumped_mass", "ex04_missing_L", "ex04_no_supports", "ex05_hz_as_rad",
           "ex05_never_none", "ex05_unwrapped_phase", "ex05_zero_based", "ex06_centre_in_fit",
@@ -55,7 +55,7 @@ def _cases():
         for p in sorted(folder.glob("*.py")):
             if p.stem in SKIP or p.stem.startswith("_"):
                 continue
-            if group == "cheat" and p.stem in ("syntax_error", "infinite_loop"):
+            if group == "cheat" and p.stem == "syntax_error":
                 group_ = "broken"
             elif group == "cheat":
                 group_ = "partial" if p.stem in HONEST else ("cheat+" if p.stem in PART_CHEAT else "cheat")
@@ -101,6 +101,7 @@ def main(argv=None) -> int:
     from mutext.grading import sandbox
     from mutext_grader import grade
     secret = secrets.token_bytes(32)
+    start = _litter()
     rows = []
     print(f"{'group':<9} {'submission':<28} {'ex':<5} {'mode':<5} {'score':>11} {'isolation':<9} {'s':>6} "
           f"{'litter':>6} {'shm MiB':>8}")
@@ -129,7 +130,9 @@ def main(argv=None) -> int:
     sandbox.FORCE_MODE = None
     bad = [r for r in rows if r[0] not in ("reference", "partial", "cheat+") and r[3] > 0]
     refs = [r for r in rows if r[0] == "reference"]
-    print(f"\n{len(rows)} gradings; submissions that do not solve and scored above 0: {len(bad)}; "
+    left = sorted(_litter() - start)
+    print(f"\nleft on the machine after all gradings (in /tmp, /var/tmp, /dev/shm): {left or 'nothing'}")
+    print(f"{len(rows)} gradings; submissions that do not solve and scored above 0: {len(bad)}; "
           f"references at full marks: {sum(r[3] == r[4] for r in refs)}/{len(refs)}; "
           f"gradings that left litter: {sum(r[7] > 0 for r in rows)}")
     return 0
