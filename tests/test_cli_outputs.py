@@ -85,7 +85,7 @@ def test_version_help_and_usage_errors(capsys):
     assert exc.value.code == 0 and "--validate" in capsys.readouterr().out
     # usage mistakes exit 2 (as argparse and 'mutext grade' do), errors in the data exit 1
     assert main(["diagnose"]) == 2 and "give a model file" in _err(capsys)
-    assert main(["diagnose", "m.toml", "d.csv", "--jobs", "2"]) == 2 and "--jobs is for --batch" in _err(capsys)
+    assert main(["diagnose", "m.toml", "d.csv", "--jobs", "2"]) == 2 and "--jobs and --scheduler are for --batch" in _err(capsys)
     assert main(["diagnose", "--batch", "x", "m.toml"]) == 2 and "--batch takes a directory" in _err(capsys)
     assert main(["nonsense"]) == 2
 

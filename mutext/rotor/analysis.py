@@ -77,7 +77,7 @@ from typing import Sequence
 import numpy as np
 import scipy.linalg as sla
 
-from ..errors import IllPosedError, ModelError
+from ..errors import IllPosedError, ModelError, MutextError
 from ..lti import blas_single_thread, mck_to_ss
 from ..response import FRFMatrix
 
@@ -269,6 +269,8 @@ def _modes(model, speed, values, n, rigid_tol, matrices) -> Modes:
         try:
             with np.errstate(over="ignore", invalid="ignore"):
                 ev, shapes = _damped_modes(M, D, K, Ks, rigid_tol, model)
+        except MutextError:
+            raise                   # e.g. a statically unstable model, said as such
         except (ValueError, np.linalg.LinAlgError):
             raise ModelError(overflow) from None
         if not np.all(np.isfinite(ev)):
