@@ -111,7 +111,7 @@ def natural_frequencies(n_elements, length, E, I, rho, A, support, n_modes):
     raise NotImplementedError
 
 
-def relative_errors(length, E, I, rho, A, support, mode=1):
+def relative_errors(length, E, I, rho, A, support, mode=1, element_counts=(2, 4, 8)):
     """(d) Convergence of a natural frequency with the number of elements.
 
     The exact Euler-Bernoulli frequencies of the uniform beam are
@@ -129,12 +129,15 @@ def relative_errors(length, E, I, rho, A, support, mode=1):
     length, E, I, rho, A, support : as in (b)
     mode : int
         Mode number ``n`` (1 = lowest).
+    element_counts : sequence of 3 int
+        The numbers of elements ``N`` to compare (the grader draws them,
+        e.g. ``(3, 4, 7)``).
 
     Returns
     -------
     numpy array of shape (3,)
-        ``(omega_N - omega_exact) / omega_exact`` of mode ``mode`` for
-        ``N = 2, 4, 8`` elements (in this order), where ``omega_N`` is the
+        ``(omega_N - omega_exact) / omega_exact`` of mode ``mode`` for each
+        ``N`` of ``element_counts`` (in this order), where ``omega_N`` is the
         frequency of (c).  The consistent mass matrix makes these positive.
     """
     raise NotImplementedError

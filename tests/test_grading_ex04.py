@@ -139,7 +139,7 @@ def test_hz_and_pinned_beta_for_cantilever_are_named():
     assert d.score == 1                      # the pinned-pinned call is right
     assert "beta L = pi, which is the pinned-pinned value" in d.output
     from mutext.rotor.analytic import beta_l
-    for *_, support, mode in CASES["d"]:
+    for _, _, support, mode, *_ in CASES["d"]:
         if support == "cantilever":
             assert f"beta_{mode} L = {beta_l('cantilever', mode):.10f}" in d.output
     assert rep.score == 6
@@ -318,16 +318,16 @@ def test_error_diagnoses(transform, text):
 
 
 def test_inaccurate_or_wrong_mode_analytic_value():
-    def rounded(length, E, I, rho, A, support, mode=1):
-        w = [sol.natural_frequencies(n, length, E, I, rho, A, support, mode)[mode - 1] for n in (2, 4, 8)]
+    def rounded(length, E, I, rho, A, support, mode=1, element_counts=(2, 4, 8)):
+        w = [sol.natural_frequencies(n, length, E, I, rho, A, support, mode)[mode - 1] for n in element_counts]
         bl = round(sol.BETA_L[support][mode - 1], 3)
         return np.array(w) / (bl**2 * math.sqrt(E * I / (rho * A * length**4))) - 1
 
     score, fb = _check("d", rounded)
     assert score < ex04.POINTS["d"] and any("ppm off: use beta L to at least 10 digits" in line for line in fb), fb
 
-    def next_mode(length, E, I, rho, A, support, mode=1):
-        w = [sol.natural_frequencies(n, length, E, I, rho, A, support, mode)[mode - 1] for n in (2, 4, 8)]
+    def next_mode(length, E, I, rho, A, support, mode=1, element_counts=(2, 4, 8)):
+        w = [sol.natural_frequencies(n, length, E, I, rho, A, support, mode)[mode - 1] for n in element_counts]
         return np.array(w) / sol.analytic_frequency(length, E, I, rho, A, support, mode + 1) - 1
 
     score, fb = _check("d", next_mode)
@@ -361,7 +361,7 @@ def test_prepare_builds_the_references_of_the_same_draw(monkeypatch):
     ex04.prepare(np.random.default_rng(5))
     cases = ex04.draw(np.random.default_rng(5))
     want = {(n, length, mat["E"], mat["d"], mat["rho"]) for n, length, mat, *_ in cases["b"] + cases["c"]}
-    want |= {(n, length, mat["E"], mat["d"], mat["rho"]) for length, mat, *_ in cases["d"] for n in (2, 4, 8)}
+    want |= {(n, length, mat["E"], mat["d"], mat["rho"]) for length, mat, _, _, counts in cases["d"] for n in counts}
     assert set(built) == want
 
 
@@ -379,6 +379,11 @@ def test_draws_vary_what_matters():
         seen["E"] |= {round(m["E"], -10) for m, _ in cases["a"]}
         seen["n"] |= {x[0] for x in cases["b"] + cases["c"]}
         seen["modes"] |= {(x[2], x[3]) for x in cases["d"]}
+        for x in cases["d"]:
+            counts = x[4]
+            assert len(counts) == 3 and list(counts) == sorted(set(counts)) and 2 <= counts[0] and counts[-1] <= 8
+            seen.setdefault("counts", set()).add(tuple(counts))
+    assert len(seen["counts"]) >= 5          # no fixed table of (d)'s errors to copy
     assert len(seen["E"]) >= 4 and seen["n"] == {3, 4, 5, 6}
     assert seen["modes"] == {("pinned", 1), ("pinned", 2), ("cantilever", 1), ("cantilever", 2), ("cantilever", 3)}
 

@@ -13,14 +13,16 @@ Questions (10 points):
 (c) ``natural_frequencies(...)``, 2 points: the lowest frequencies in rad/s
     of two beams (1 point each).
 (d) ``relative_errors(...)``, 3 points: ``(omega_N - omega_exact)/omega_exact``
-    for N = 2, 4, 8 elements, three beams and modes (1 point each).
+    for three element counts N drawn per call (2-3, 3-5, 5-8), three beams and
+    modes (1 point each).
 
 Inputs are drawn per run from the generator the grader passes
 (:func:`draw`): materials (steel, aluminium, titanium, brass, E and rho
 within 5 %), solid sections of 10-40 mm, a short (0.15-0.6 m) and a long
 (1.6-3 m) element in (a), beams of 0.5-2 m with 3-5 elements in (b) and 3-6
 in (c) (3 or 4 modes), the modes of (d) (pinned-pinned mode 1 or 2,
-cantilever mode 1, cantilever mode 2 or 3), and the order of the calls.
+cantilever mode 1, cantilever mode 2 or 3) with their element counts, and
+the order of the calls.
 :func:`prepare` builds the references of the same draw while the child runs.
 
 The references are computed with :mod:`mutext.rotor` (Timoshenko shaft
@@ -38,9 +40,9 @@ finite-element ones are asked) earn nothing
 (``tests/grading_submissions/trivial/ex04_*.py``).  Sizes are checked before
 anything is computed: an array of another shape than asked, e.g. matrices
 far larger than ``2N x 2N``, scores 0 for that call with a message and is
-never factorised.  The errors of (d) are dimensionless: they depend only on
-the support and the mode, not on the drawn beam, so a table of them
-(5 cases x 3 numbers) copied from a working solution would pass (d).
+never factorised.  The errors of (d) are dimensionless (they depend only on
+the support, the mode and N, not on the beam): the element counts are drawn
+per call, so a table of them copied from one run does not pass another.
 
 Feedback names the call by number with its support, number of elements and
 modes (arguments, not answers) and the usual mistakes, never a reference
@@ -82,6 +84,10 @@ ELEMENTS_C = (3, 6)                          # ... and of (c)
 MODES_C = (3, 4)                             # frequencies asked in (c)
 #: (support, modes one is drawn from) of the three calls of (d), shuffled
 D_CASES = (("pinned", (1, 2)), ("cantilever", (1,)), ("cantilever", (2, 3)))
+#: element counts of (d): three increasing counts drawn from these ranges (the largest at most 8, where the
+#: error of a cubic element is still far above rounding), so the errors asked differ from run to run and no
+#: table of them can be copied
+D_COUNTS = ((2, 3), (3, 5), (5, 8))
 DOF_NAMES = ["w1", "theta1", "w2", "theta2"]
 ROT = np.array([0, 1, 0, 1])          # 1 where the element DOF is a rotation
 
@@ -107,13 +113,22 @@ def _length(rng, lo_hi):
     return round(float(math.exp(rng.uniform(*np.log(lo_hi)))), 3)
 
 
+def _counts(rng):
+    """Three increasing element counts for (d), from :data:`D_COUNTS`."""
+    out = []
+    for lo, hi in D_COUNTS:
+        lo = max(lo, out[-1] + 1) if out else lo
+        out.append(int(rng.integers(lo, hi + 1)))
+    return tuple(out)
+
+
 def draw(rng):
     """The graded inputs of one run, from the numpy Generator ``rng``.
 
     Returns a dict: ``"a"``, two ``(material, L)`` (one short and one long element, shuffled); ``"b"``,
     ``(n, length, material, support)`` of a pinned-pinned and a cantilever beam (shuffled); ``"c"``,
     ``(n, length, material, support, n_modes)`` likewise; ``"d"``, three ``(length, material, support,
-    mode)`` (:data:`D_CASES`, shuffled).  A material is a dict ``E``, ``rho``, ``d`` (the section's
+    mode, element_counts)`` (:data:`D_CASES`, :data:`D_COUNTS`, shuffled).  A material is a dict ``E``, ``rho``, ``d`` (the section's
     diameter, which the reference needs; the child gets ``I`` and ``A``).
     """
     a = [(_material(rng), _length(rng, lo_hi)) for lo_hi in ELEMENT_LENGTHS]
@@ -124,7 +139,8 @@ def draw(rng):
     c = [(int(rng.integers(ELEMENTS_C[0], ELEMENTS_C[1] + 1)), _length(rng, BEAM_LENGTH), _material(rng), sup,
           int(rng.integers(MODES_C[0], MODES_C[1] + 1))) for sup in ("pinned", "cantilever")]
     c = [c[i] for i in rng.permutation(2)]
-    d = [(_length(rng, BEAM_LENGTH), _material(rng), sup, int(rng.choice(modes))) for sup, modes in D_CASES]
+    d = [(_length(rng, BEAM_LENGTH), _material(rng), sup, int(rng.choice(modes)), _counts(rng))
+         for sup, modes in D_CASES]
     d = [d[i] for i in rng.permutation(3)]
     return {"a": a, "b": b, "c": c, "d": d}
 
@@ -194,10 +210,10 @@ def exact_frequency(length, E, d, rho, support, mode):
     return euler_bernoulli_frequency(mode, length, E, rho, *section(d), support)
 
 
-def reference_errors(length, E, d, rho, support, mode):
+def reference_errors(length, E, d, rho, support, mode, counts=(2, 4, 8)):
     exact = exact_frequency(length, E, d, rho, support, mode)
     return np.array([frequencies(*supported(n, length, E, d, rho, support))[mode - 1] / exact - 1.0
-                     for n in (2, 4, 8)])
+                     for n in counts])
 
 
 def _lumped_free_free(n, length, E, d, rho):
@@ -218,7 +234,7 @@ def prepare(rng=None):
         return
     cases = draw(rng)
     beams = [(n, length, mat) for n, length, mat, *_ in cases["b"] + cases["c"]]
-    beams += [(n, length, mat) for length, mat, *_ in cases["d"] for n in (2, 4, 8)]
+    beams += [(n, length, mat) for length, mat, _, _, counts in cases["d"] for n in counts]
     for n, length, mat in beams:
         free_free(n, length, mat["E"], mat["d"], mat["rho"])
 
@@ -540,7 +556,7 @@ def _errors_match(e, ref):
     return e.shape == ref.shape and bool(np.all(np.abs(e - ref) <= RTOL_ERR * np.abs(ref) + ATOL_ERR))
 
 
-def _diagnose_errors(e, ref, length, E, d, rho, support, mode):
+def _diagnose_errors(e, ref, length, E, d, rho, support, mode, counts=(2, 4, 8)):
     exact = exact_frequency(length, E, d, rho, support, mode)
     w_fe = exact * (1 + ref)
     if np.all(np.isfinite(e)) and np.all(np.abs(e + 1) < 1e-3):
@@ -552,7 +568,7 @@ def _diagnose_errors(e, ref, length, E, d, rho, support, mode):
         return "the error has the wrong reference: return (omega_N - omega_exact) / omega_exact"
     if _errors_match(e, w_fe - exact):
         return "this is the absolute error in rad/s: divide by the exact frequency"
-    lumped = _lumped_errors(length, E, d, rho, support, mode, exact)
+    lumped = _lumped_errors(length, E, d, rho, support, mode, exact, counts)
     if lumped is not None and _errors_match(e, lumped):
         return "these are the errors of a lumped mass matrix; use the consistent mass matrix of (a)"
     if np.all(np.isfinite(e)) and np.all(e != -1):
@@ -589,7 +605,7 @@ def _diagnose_errors(e, ref, length, E, d, rho, support, mode):
                     "lie above the exact ones (a Rayleigh-Ritz upper bound); a lumped mass matrix or a wrong "
                     "analytic value gives negative errors")
     k = int(np.argmax(np.abs(e - ref) / (np.abs(ref) + ATOL_ERR)))
-    return (f"N = {(2, 4, 8)[k]} is furthest off; the finite-element frequencies (see (c)) or the analytic "
+    return (f"N = {counts[k]} is furthest off; the finite-element frequencies (see (c)) or the analytic "
             "value are off")
 
 
@@ -600,10 +616,10 @@ def _one_digit(x):
     return f"{round(x, -int(math.floor(math.log10(x)))):g}"
 
 
-def _lumped_errors(length, E, d, rho, support, mode, exact):
+def _lumped_errors(length, E, d, rho, support, mode, exact, counts=(2, 4, 8)):
     """The errors of (d) with a lumped mass matrix, or None where it has fewer than ``mode`` finite modes."""
     out = []
-    for n in (2, 4, 8):
+    for n in counts:
         w = frequencies(*reduce(*_lumped_free_free(n, length, E, d, rho), constrained(n, support)))
         if w.size < mode:
             return None
@@ -617,25 +633,28 @@ def _check_errors(outcomes, calls):
     for call, tag, e in returned(outcomes, calls, fb, as_array, "relative_errors()"):
         length, E, I, rho, A, support = call.args
         mode = call.kwargs["mode"]
+        counts = tuple(call.kwargs["element_counts"])
         d = call.kwargs_ref["d"]
         e = e.ravel()
         if e.size != 3:                # before any computation: a huge array is never analysed
-            fb.append(f"{tag} expected 3 relative errors (N = 2, 4, 8), got {e.size} numbers")
+            fb.append(f"{tag} expected 3 relative errors (one per element count asked), got {e.size} numbers")
             continue
-        ref = reference_errors(length, E, d, rho, support, mode)
+        ref = reference_errors(length, E, d, rho, support, mode, counts)
         if _errors_match(e, ref):
             score += per
             n_ok += 1
             continue
-        fb.append(f"{tag} " + _diagnose_errors(e, ref, length, E, d, rho, support, mode))
+        fb.append(f"{tag} " + _diagnose_errors(e, ref, length, E, d, rho, support, mode, counts))
     if n_ok == len(calls):
-        rates = []
+        orders = []
         for call in calls:
             length, E, I, rho, A, support = call.args
-            ref = reference_errors(length, E, call.kwargs_ref["d"], rho, support, call.kwargs["mode"])
-            rates.append(ref[:-1] / ref[1:])
-        fb.insert(0, "correct: all errors match; each halving of the elements divides the error by about "
-                     f"{np.median(np.concatenate(rates)):.0f} (h^4 convergence of cubic elements)")
+            counts = np.array(call.kwargs["element_counts"], float)
+            ref = reference_errors(length, E, call.kwargs_ref["d"], rho, support, call.kwargs["mode"],
+                                   tuple(call.kwargs["element_counts"]))
+            orders.append(-np.log(ref[-1] / ref[0]) / np.log(counts[-1] / counts[0]))
+        fb.insert(0, "correct: all errors match; the error falls about as N^-"
+                     f"{np.median(orders):.1f} with the number of elements N (h^4 convergence of cubic elements)")
     return score, fb
 
 
@@ -668,8 +687,10 @@ def questions(rng=None):
                           sup) for i, (n, length, mat, sup) in enumerate(cases["b"])]
     c_calls = [_beam_call(f"beam {i + 1} of {len(cases['c'])}: {SUPPORT_TEXT[sup]}, {n} elements, {k} modes", n,
                           length, mat, sup, k) for i, (n, length, mat, sup, k) in enumerate(cases["c"])]
-    d_calls = [_beam_call(f"beam {i + 1} of {len(cases['d'])}: {SUPPORT_TEXT[sup]}, mode {mode}", None, length, mat,
-                          sup, kwargs={"mode": mode}) for i, (length, mat, sup, mode) in enumerate(cases["d"])]
+    d_calls = [_beam_call(f"beam {i + 1} of {len(cases['d'])}: {SUPPORT_TEXT[sup]}, mode {mode}, "
+                          f"N = {', '.join(map(str, counts))}", None, length, mat, sup,
+                          kwargs={"mode": mode, "element_counts": list(counts)})
+               for i, (length, mat, sup, mode, counts) in enumerate(cases["d"])]
     return [
         Question("a", "element_matrices", "element stiffness and consistent mass matrices", POINTS["a"], "array",
                  a_calls, lambda oc: _check_element(oc, a_calls)),

@@ -36,5 +36,5 @@ def natural_frequencies(n_elements, length, E, I, rho, A, support, n_modes):
     return np.sqrt(scipy.linalg.eigh(K, M, eigvals_only=True)[:n_modes])
 
 
-def relative_errors(length, E, I, rho, A, support, mode=1):
+def relative_errors(length, E, I, rho, A, support, mode=1, element_counts=(2, 4, 8)):
     raise NotImplementedError

@@ -34,7 +34,7 @@ def natural_frequencies(n_elements, length, E, I, rho, A, support, n_modes):
     return np.sqrt(scipy.linalg.eigh(K, M, eigvals_only=True)[:n_modes]) / (2 * np.pi)   # Hz
 
 
-def relative_errors(length, E, I, rho, A, support, mode=1):
+def relative_errors(length, E, I, rho, A, support, mode=1, element_counts=(2, 4, 8)):
     exact = (mode * np.pi) ** 2 * np.sqrt(E * I / (rho * A * length**4))   # pinned-pinned value for both
     return np.array([2 * np.pi * natural_frequencies(n, length, E, I, rho, A, support, mode)[mode - 1] / exact - 1
-                     for n in (2, 4, 8)])
+                     for n in element_counts])

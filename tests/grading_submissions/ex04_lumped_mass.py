@@ -36,7 +36,7 @@ def natural_frequencies(n_elements, length, E, I, rho, A, support, n_modes):
     return np.sqrt(scipy.linalg.eigh(K, M, eigvals_only=True)[:n_modes])
 
 
-def relative_errors(length, E, I, rho, A, support, mode=1):
+def relative_errors(length, E, I, rho, A, support, mode=1, element_counts=(2, 4, 8)):
     exact = BETA_L[support][mode - 1] ** 2 * np.sqrt(E * I / (rho * A * length**4))
     return np.array([natural_frequencies(n, length, E, I, rho, A, support, mode)[-1] / exact - 1
-                     for n in (2, 4, 8)])
+                     for n in element_counts])

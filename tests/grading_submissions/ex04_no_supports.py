@@ -33,8 +33,8 @@ def natural_frequencies(n_elements, length, E, I, rho, A, support, n_modes):
     return np.sqrt(np.abs(lam[:n_modes])) / (2 * np.pi)      # in Hz
 
 
-def relative_errors(length, E, I, rho, A, support, mode=1):
+def relative_errors(length, E, I, rho, A, support, mode=1, element_counts=(2, 4, 8)):
     beta_l = {"pinned": np.pi * mode, "cantilever": [1.875104068712, 4.694091132974, 7.854757438238][mode - 1]}
     exact = beta_l[support] ** 2 * np.sqrt(E * I / (rho * A * length**4))
     return np.array([natural_frequencies(n, length, E, I, rho, A, support, mode)[mode - 1] / exact - 1
-                     for n in (2, 4, 8)])
+                     for n in element_counts])

@@ -67,8 +67,8 @@ def analytic_frequency(length, E, I, rho, A, support, mode):
     return bl**2 * np.sqrt(E * I / (rho * A * length**4))
 
 
-def relative_errors(length, E, I, rho, A, support, mode=1):
-    """``(omega_N - omega_exact) / omega_exact`` of mode ``mode`` for N = 2, 4, 8 elements."""
+def relative_errors(length, E, I, rho, A, support, mode=1, element_counts=(2, 4, 8)):
+    """``(omega_N - omega_exact) / omega_exact`` of mode ``mode`` for each N of ``element_counts``."""
     exact = analytic_frequency(length, E, I, rho, A, support, mode)
     return np.array([natural_frequencies(n, length, E, I, rho, A, support, mode)[mode - 1] / exact - 1.0
-                     for n in (2, 4, 8)])
+                     for n in element_counts])
