@@ -73,10 +73,11 @@ def test_complex_scalar_is_modulus(z):
 def test_real_scalar_with_imaginary_entry_has_mu_zero(y):
     S = BlockStructure([Block.real()])
     M = np.array([[1j * y]])
-    up = mu_upper(M, S, real="dg")
-    assert up.method == "lmi-dg"
-    assert up.value < 1e-6 * abs(y)
-    check_certificate(M, S, up)
+    for method in ("auto", "lmi"):
+        up = mu_upper(M, S, method=method, real="dg")
+        assert up.method == {"auto": "fast-dg", "lmi": "lmi-dg"}[method]
+        assert up.value < 1e-6 * abs(y)
+        check_certificate(M, S, up)
     assert mu_lower(M, S).value == 0.0
     # treating the parameter as complex loses this: the bound is |z|
     assert mu_upper(M, S, real="complex").value == pytest.approx(abs(y), rel=1e-6)
@@ -347,7 +348,7 @@ def test_mixed_real_complex_example():
                        + [Block.full(2, 2, "performance")])
     M = crandn(rng, 6, 6) * 0.5
     b = mu_bounds(M, S)
-    assert b.upper.method == "lmi-dg" and b.lower.method == "real-search"
+    assert b.upper.method == "fast-dg" and b.lower.method == "real-search"
     check_lower(M, S, b.lower)
     check_certificate(M, S, b.upper)
     assert b.lower.value <= b.upper.value

@@ -43,7 +43,7 @@ def _both(M, S: BlockStructure, method: str, real: str, rng, gap_tol: float = 1e
     return up, lo
 
 
-def mu_bounds(M, structure: BlockStructure, *, method: str = "lmi", real: str = "dg", rng=0) -> MuBounds:
+def mu_bounds(M, structure: BlockStructure, *, method: str = "auto", real: str = "dg", rng=0) -> MuBounds:
     r"""Both bounds: :func:`mu_lower`, then :func:`mu_upper` with the lower bound
     starting its bisection, then (complex structures, if they differ) the lower
     bound again from the upper bound's scalings.

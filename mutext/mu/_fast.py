@@ -7,6 +7,7 @@ congruent form, in coordinates that carry over from one frequency to the next
 from __future__ import annotations
 
 import numpy as np
+from scipy.linalg.lapack import zheevd as _zheevd
 
 from ._certificate import MuUpper, _d_from_matrices, _diag_result
 from ._osborne import _osborne
@@ -112,17 +113,23 @@ class _DGParams:
         r"""(lambda, grad log lambda) with :math:`\lambda = \lambda_{\max}(H)` (the squared bound)."""
         S = self.S
         if self.diag:
-            # one scaling per block (coordinates 0..m-1), G-hat on 1 x 1 real blocks after them
+            # one scaling per block (coordinates 0..m-1), G-hat on 1 x 1 real blocks after them;
+            # written with few numpy calls: this is the inner loop of the default bound
             m = self.m
             e = np.exp(x[:m])
-            A = e[S.col_block][:, None] * M / e[S.row_block][None, :]
-            GA = None
+            A = (e[S.col_block][:, None] * M) * (1.0 / e)[S.row_block]
+            H = A.conj().T @ A
             if self.nreal:
                 gs = np.sinh(x[m:])
-                # G A: G maps column gcol of A (z of the real block) to row grow (its w)
-                GA = np.zeros((S.nrows, S.nrows), complex)
-                GA[self.grow] = (beta0 * gs)[:, None] * A[self.gcol]
-            lam, v = self._top(A, GA)
+                # j(GA - (GA)^H), G mapping column gcol of A (z of the real block) to row grow
+                # (its w): GA has the rows grow only
+                T = 1j * ((beta0 * gs)[:, None] * A[self.gcol])
+                H[self.grow] += T
+                H[:, self.grow] += T.conj().T
+            w, V, info = _zheevd(H)
+            if info != 0:
+                raise np.linalg.LinAlgError("eigenvalues of the scaled form did not converge")
+            lam, v = float(w[-1]), V[:, -1]
             if not grad:
                 return lam, None
             a = A @ v
@@ -221,7 +228,7 @@ class _DGParams:
 
 
 def _bfgs(fun, x0, B0=None, max_iter: int = 100, ftol: float = 1e-10, max_step: float = 1.0,
-          max_eval: int = 400):
+          max_eval: int = 400, info: dict | None = None):
     r"""Minimise a (possibly nonsmooth at optimum) function by BFGS with a weak Wolfe line search.
 
     The line search of Lewis and Overton [LO]_ (bisection/doubling on the
@@ -230,7 +237,9 @@ def _bfgs(fun, x0, B0=None, max_iter: int = 100, ftol: float = 1e-10, max_step: 
     ``ftol`` (absolute: ``f`` is a logarithm) twice in a row or the line search fails.
     ``max_eval`` bounds the function evaluations (the result is then the best
     point found, still a valid bound).  Returns (f, x, inverse Hessian
-    approximation, evaluations).
+    approximation, evaluations); ``info["stop"]`` (if given) says why it stopped:
+    ``"ftol"`` (converged), ``"stall"`` (the line search failed, typically at a kink of
+    the largest eigenvalue) or ``"budget"``.
     """
     x = x0.copy()
     f, g = fun(x)
@@ -239,6 +248,7 @@ def _bfgs(fun, x0, B0=None, max_iter: int = 100, ftol: float = 1e-10, max_step: 
     B = np.eye(n) if B0 is None else B0.copy()
     reset = B0 is None
     small = 0
+    stop = "budget"
     for _ in range(max_iter):
         if nev >= max_eval:
             break
@@ -249,6 +259,7 @@ def _bfgs(fun, x0, B0=None, max_iter: int = 100, ftol: float = 1e-10, max_step: 
             p = -g
             gp = float(g @ p)
             if not gp < 0:
+                stop = "stall"
                 break
         # at most a factor e^max_step in any scaling per step (a stale or nearly
         # singular Hessian approximation points far out along flat directions)
@@ -274,6 +285,7 @@ def _bfgs(fun, x0, B0=None, max_iter: int = 100, ftol: float = 1e-10, max_step: 
                 g = fun(x)[1]
                 nev += 1
             if reset:
+                stop = "stall"
                 break
             # a stale Hessian approximation (a warm start from another matrix): restart once
             B = np.eye(n)
@@ -289,7 +301,10 @@ def _bfgs(fun, x0, B0=None, max_iter: int = 100, ftol: float = 1e-10, max_step: 
             B = B + ((sy + y @ By) * rho * rho) * (s[:, None] * s) - rho * (By[:, None] * s + s[:, None] * By)
         small = small + 1 if drop < ftol else 0
         if small >= 2:
+            stop = "ftol"
             break
+    if info is not None:
+        info["stop"] = stop
     return f, x, B, nev
 
 
@@ -300,14 +315,14 @@ _G_CLIP = 8.0
 
 
 def _upper_fast(M, S: BlockStructure, params: _DGParams, x0=None, B0=None, ftol: float = 1e-10,
-                max_eval: int = 400):
+                max_eval: int = 400, info: dict | None = None, osborne_tol: float = 0.0):
     """Fast D (or D-G) bound at one matrix, from coordinates ``x0`` (None: Osborne balancing).
 
     Returns (MuUpper, x, inverse Hessian) with the value recomputed from the
     scalings' coordinates (the exact largest eigenvalue of the congruent form).
     """
     if x0 is None:
-        x0 = params.initial(np.exp(_osborne(M, S)))
+        x0 = params.initial(np.exp(_osborne(M, S, tol=osborne_tol)))
     else:
         # a warm start: G-hat near a previous frequency's, but not the large values
         # of a frequency where the infimum is approached as G -> infinity (a flat
@@ -327,17 +342,17 @@ def _upper_fast(M, S: BlockStructure, params: _DGParams, x0=None, B0=None, ftol:
         x[free] = y
         if np.abs(y).max(initial=0.0) > 200.0:
             return np.inf, np.zeros(free.size)     # a line-search trial far out: reject it
-        with np.errstate(over="ignore", invalid="ignore"):
-            try:
-                lam, g = params.value_grad(x, M, beta0)
-            except np.linalg.LinAlgError:
-                return np.inf, np.zeros(free.size)
+        try:
+            lam, g = params.value_grad(x, M, beta0)
+        except (np.linalg.LinAlgError, ValueError):
+            return np.inf, np.zeros(free.size)
         if not np.isfinite(lam):
             return np.inf, np.zeros(free.size)
         if not lam > 0:
             return -np.inf, np.zeros(free.size)
         return np.log(lam), g[free]
-    _, y, B, nev = _bfgs(fun, x0[free], B0, ftol=ftol, max_eval=max_eval)
+    with np.errstate(over="ignore", invalid="ignore"):
+        _, y, B, nev = _bfgs(fun, x0[free], B0, ftol=ftol, max_eval=max_eval, info=info)
     x = x0.copy()
     x[free] = y
     lam, _ = params.value_grad(x, M, beta0, grad=False)
@@ -348,17 +363,17 @@ def _upper_fast(M, S: BlockStructure, params: _DGParams, x0=None, B0=None, ftol:
 
 
 def _fast_at(M, S: BlockStructure, params: _DGParams, x0=None, B0=None, ftol: float = 1e-10,
-             max_eval: int = 400):
+             max_eval: int = 400, info: dict | None = None, osborne_tol: float = 0.0):
     """:func:`_upper_fast` with the shortcuts of :func:`mu_upper` (one full block, ``M = 0``,
     extreme norms); returns (MuUpper, coordinates or None, inverse Hessian or None)."""
     nrm = _norm2(M)
     if nrm == 0 or (len(S) == 1 and S.blocks[0].kind == "full"):
         return _diag_result(M, S, np.ones(len(S)), "sigma"), None, None
     if not 1e-100 <= nrm <= 1e100:
-        up, x, B = _upper_fast(M / nrm, S, params, x0, B0, ftol, max_eval)
+        up, x, B = _upper_fast(M / nrm, S, params, x0, B0, ftol, max_eval, info, osborne_tol)
         return MuUpper(float(up.value * nrm), up.method, d=up.d, Dl=up.Dl, Dr=up.Dr,
                        G=None if up.G is None else up.G * nrm, iterations=up.iterations), x, B
-    return _upper_fast(M, S, params, x0, B0, ftol, max_eval)
+    return _upper_fast(M, S, params, x0, B0, ftol, max_eval, info, osborne_tol)
 
 
 def _fast_polish(M, S: BlockStructure, params: _DGParams, x0=None):
@@ -373,4 +388,29 @@ def _fast_polish(M, S: BlockStructure, params: _DGParams, x0=None):
         if not up2.value < up.value * (1 - 1e-10):
             break
         up, x = up2, x2
+    return up, x
+
+
+#: default bound (``mu_upper(method="auto")``): tolerance of the descent on log lambda_max
+_AUTO_FTOL = 1e-11
+
+
+def _fast_default(M, S: BlockStructure, params: _DGParams, always: bool = False):
+    """The fast bound as the default of :func:`mu_upper`: one descent from Osborne balancing,
+    restarted from the point reached (fresh Hessian approximation) only while the line search
+    stalls at a kink of lambda_max and the restart still lowers the bound.
+    Returns (MuUpper with the evaluations of all descents, coordinates or None)."""
+    info = {}
+    up, x, _ = _fast_at(M, S, params, None, None, ftol=_AUTO_FTOL, max_eval=300, info=info,
+                        osborne_tol=1e-2)
+    nev = up.iterations
+    for _ in range(_FAST_RESTARTS):
+        if x is None or (info.get("stop") == "ftol" and not always):
+            break
+        up2, x2, _ = _fast_at(M, S, params, x, None, ftol=_AUTO_FTOL, max_eval=200, info=info)
+        nev += up2.iterations
+        if not up2.value < up.value * (1 - 1e-10):
+            break
+        up, x = up2, x2
+    up.iterations = nev
     return up, x

@@ -11,13 +11,14 @@ import numpy as np
 from ._structure import BlockStructure
 
 
-def _osborne(M, S: BlockStructure, iterations: int = 30) -> np.ndarray:
+def _osborne(M, S: BlockStructure, iterations: int = 30, tol: float = 0.0) -> np.ndarray:
     """Log-scalings (one per block) that balance the matrix of block norms (Osborne).
 
     Only a starting point for the ellipsoid method.  Zero block norms are
     replaced by 1e-14 of the largest one, so that a reducible pattern (a
     triangular M, whose infimum over D is not attained) still gives finite,
-    strongly graded scalings; they are kept within exp(+-30).
+    strongly graded scalings; they are kept within exp(+-30).  With ``tol > 0`` the sweeps
+    stop once no log-scaling moves by more than ``tol``.
     """
     m = len(S)
     if m == 1:
@@ -31,12 +32,18 @@ def _osborne(M, S: BlockStructure, iterations: int = 30) -> np.ndarray:
     B = np.maximum(B, 1e-14)
     np.fill_diagonal(B, 0.0)
     x = np.zeros(m)
+    B2 = B * B
     for _ in range(iterations):
+        moved = 0.0
         for i in range(m):
-            e = np.exp(x)
-            r = np.sqrt(np.sum((B[i, :] / e) ** 2))      # row i of D B D^-1, without d_i
-            c = np.sqrt(np.sum((B[:, i] * e) ** 2))      # column i, without 1/d_i
-            x[i] = np.clip(0.5 * (np.log(c) - np.log(r)), -30.0, 30.0)
+            e2 = np.exp(2.0 * x)
+            r2 = B2[i, :] @ (1.0 / e2)                   # row i of D B D^-1, squared, without d_i
+            c2 = B2[:, i] @ e2                           # column i, without 1/d_i
+            xi = min(max(0.25 * (np.log(c2) - np.log(r2)), -30.0), 30.0)
+            moved = max(moved, abs(xi - x[i]))
+            x[i] = xi
+        if moved <= tol:
+            break
     return x - x[-1]
 
 

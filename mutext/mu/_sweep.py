@@ -18,7 +18,7 @@ from ._fast import _DGParams, _fast_at, _fast_polish
 from ._lmi import _lmi_bisect
 from ._lower import mu_lower
 from ._structure import BlockStructure, _as_structure
-from ._upper import mu_upper
+from ._upper import _certify, mu_upper
 
 
 def _resonance_points(poles, lo: float = 0.0, hi: float = np.inf) -> np.ndarray:
@@ -130,7 +130,8 @@ _POLISH_BAND = 0.01
 _POLISH_MAX, _LMI_MAX = 12, 4
 
 
-def _fast_peaks(res, coords, response, S: BlockStructure, params: _DGParams, certify: bool):
+def _fast_peaks(res, coords, response, S: BlockStructure, params: _DGParams, certify: bool,
+                checked: bool = False):
     """Polish the largest values of a fast sweep and check them by the LMI (in place).
 
     The grid pass stops each descent after a few dozen evaluations (a valid
@@ -140,7 +141,8 @@ def _fast_peaks(res, coords, response, S: BlockStructure, params: _DGParams, cer
     ``_POLISH_BAND`` of the largest get a longer descent from their own
     scalings and from a cold (Osborne) start; then, from the largest down, the
     LMI is run from the polished scalings until the largest value left
-    unchecked is below the largest checked value.
+    unchecked is below the largest checked value.  ``checked``: a polished value is kept
+    only if its scalings reproduce it (:func:`_certify`).
     """
     # a descent that stalled shows as a spike above both neighbours: redo the largest
     # spikes from the neighbours' scalings
@@ -155,7 +157,7 @@ def _fast_peaks(res, coords, response, S: BlockStructure, params: _DGParams, cer
             if x0 is None:
                 continue
             up, x, _ = _fast_at(M, S, params, x0, None, ftol=1e-10, max_eval=2 * _GRID_EVALS)
-            if up.value < res[w][0].value:
+            if up.value < res[w][0].value and (not checked or _certify(M, S, up) is not None):
                 res[w], coords[w] = (up, res[w][1]), x
     ws = sorted(res, key=lambda w: -res[w][0].value)
     top = res[ws[0]][0].value
@@ -164,7 +166,7 @@ def _fast_peaks(res, coords, response, S: BlockStructure, params: _DGParams, cer
         best = res[w][0]
         for x0 in (coords.get(w), None):
             up, x = _fast_polish(M, S, params, x0)
-            if up.value < best.value:
+            if up.value < best.value and (not checked or _certify(M, S, up) is not None):
                 best, coords[w] = up, x
         res[w] = (best, res[w][1])
     if not certify:
@@ -196,7 +198,7 @@ def _fast_peaks(res, coords, response, S: BlockStructure, params: _DGParams, cer
         level = max(level, up.value)
 
 
-def mu_sweep(sys, structure: BlockStructure, omega=None, *, method: str = "osborne", real: str = "dg",
+def mu_sweep(sys, structure: BlockStructure, omega=None, *, method: str = "auto", real: str = "dg",
              lower="peaks", refine: bool = True, npeaks: int = 3, rng=0, xtol: float = 1e-7,
              certify: bool = True) -> MuSweep:
     r"""Bounds on :math:`\mu` of a system's frequency response over a frequency grid.
@@ -210,7 +212,10 @@ def mu_sweep(sys, structure: BlockStructure, omega=None, *, method: str = "osbor
     omega : array_like, optional
         Frequencies (rad/s, non-negative).  Default: :func:`default_grid`.
     method, real
-        Upper-bound method (see :func:`mu_upper`).  ``"fast"``: the D-G (or D)
+        Upper-bound method (see :func:`mu_upper`).  ``"auto"`` (default): the
+        ``"fast"`` sweep below, with every value recomputed from its scalings
+        (the generalised eigenvalue of the D-G inequality, as :func:`dg_bound`)
+        and the LMI at the frequencies where that does not reproduce it.  ``"fast"``: the D-G (or D)
         bound by quasi-Newton descent (BFGS with the weak Wolfe line search of
         Lewis and Overton [LO]_) on :math:`\log\lambda_{\max}` of the scaled
         form, warm-started from the previous frequency's scalings and
@@ -241,7 +246,7 @@ def mu_sweep(sys, structure: BlockStructure, omega=None, *, method: str = "osbor
     xtol : float
         Relative frequency tolerance of the peak refinement.
     certify : bool
-        ``method="fast"``: run the LMI (:func:`mu_upper`, ``method="lmi"``)
+        ``method="fast"`` or ``"auto"``: run the LMI (:func:`mu_upper`, ``method="lmi"``)
         at the largest values, from the fast scalings, until the largest value
         left unchecked is below the largest checked one.  The LMI either lowers
         the bound there or confirms it within ``1e-5`` relative (its
@@ -283,8 +288,8 @@ def mu_sweep(sys, structure: BlockStructure, omega=None, *, method: str = "osbor
         lower = "none"
     if lower not in ("peaks", "all", "none"):
         raise ModelError(f"lower must be 'peaks', 'all' or 'none', got {lower!r}")
-    if method not in ("lmi", "osborne", "fast"):
-        raise ModelError(f"method must be 'lmi', 'osborne' or 'fast', got {method!r}")
+    if method not in ("auto", "lmi", "osborne", "fast"):
+        raise ModelError(f"method must be 'auto', 'lmi', 'osborne' or 'fast', got {method!r}")
     if real not in ("dg", "complex"):
         raise ModelError(f"real must be 'dg' or 'complex', got {real!r}")
     if not isinstance(npeaks, (int, np.integer)) or npeaks < 0:
@@ -307,7 +312,8 @@ def mu_sweep(sys, structure: BlockStructure, omega=None, *, method: str = "osbor
     H = response(omega)
     res = {}
 
-    fast = method == "fast"
+    fast = method in ("fast", "auto")
+    checked = method == "auto"
     if fast:
         params = _DGParams(structure, real == "dg" and structure.has_real)
         coords = {}                  # frequency -> coordinates of its fast scalings
@@ -333,6 +339,10 @@ def mu_sweep(sys, structure: BlockStructure, omega=None, *, method: str = "osbor
                 up2, x2, B2 = _fast_at(Mw, structure, params, None, None, ftol=1e-9, max_eval=4 * _GRID_EVALS)
                 if up2.value < up.value:
                     up, x, B = up2, x2, B2
+            if checked and _certify(Mw, structure, up) is None:
+                # the scalings do not reproduce the value (rounding in badly scaled
+                # scalings): the LMI there, and no warm start from them
+                up, x, B = mu_upper(Mw, structure, method="lmi", real=real), None, None
             coords[float(w)] = x
             warm["x"], warm["B"] = x, B
             warm["top"] = max(warm["top"], up.value)
@@ -378,7 +388,7 @@ def mu_sweep(sys, structure: BlockStructure, omega=None, *, method: str = "osbor
                     d = a + gr * (b - a)
                     fd = g(d)
     if fast:
-        _fast_peaks(res, coords, response, structure, params, certify)
+        _fast_peaks(res, coords, response, structure, params, certify, checked)
     ws = np.array(sorted(res))
     ups = np.array([res[w][0].value for w in ws])
     if lower == "peaks":
