@@ -1,0 +1,140 @@
+"""The default upper bound of mu_upper / mu_sweep (``method="auto"``): SLICOT AB13MD as the
+reference where it applies (1 x 1 real, square full complex blocks), the LMI elsewhere; every
+value certified by its scalings, the LMI only as fallback."""
+import numpy as np
+import pytest
+from mu_cases import ab13md_structure, crandn
+
+import mutext.mu._lmi as lmi_module
+import mutext.mu._upper as upper_module
+from mutext.lti import freqresp, ss
+from mutext.mu import Block, BlockStructure, dg_bound, mu_bounds, mu_sweep, mu_upper
+
+#: AB13MD-compatible structures: complex 1 x 1 ("c1"), full 2 x 2, 1 x 1 real
+KINDS = [["c1", "c1", "full2"], ["real", "c1", "full2"], ["real", "real", "c1", "c1"],
+         ["full2", "real", "full2"], ["real", "real", "real", "c1"]]
+
+
+def _matrix(rng, S, variant):
+    M = crandn(rng, S.ncols, S.nrows)
+    if variant == 1:
+        M = M.real.astype(complex)              # real M: G matters most
+    elif variant == 2:
+        M = M.real + 0.1j * M.imag
+    return M
+
+
+def _certified(M, S, up):
+    assert dg_bound(M, S, up.Dl, up.Dr, up.G) == pytest.approx(up.value, rel=1e-9, abs=1e-12)
+
+
+@pytest.mark.parametrize("k", range(len(KINDS)))
+@pytest.mark.parametrize("variant", range(3))
+def test_default_equals_ab13md(k, variant):
+    ab13md = pytest.importorskip("slycot").ab13md
+    S, nb, it = ab13md_structure(KINDS[k])
+    rng = np.random.default_rng(1000 + 10 * k + variant)
+    for _ in range(3):
+        M = _matrix(rng, S, variant)
+        up = mu_upper(M, S)
+        ref = ab13md(M, nb, it)[0]
+        assert up.method == ("fast-dg" if S.has_real else "fast-d")
+        _certified(M, S, up)
+        assert up.value <= ref * (1 + 1e-6)
+        if up.value < ref * (1 - 1e-6):
+            # below AB13MD: AB13MD stopped short of the optimal D-G scalings; the LMI agrees
+            # with the default, not with AB13MD
+            lmi = mu_upper(M, S, method="lmi")
+            assert up.value == pytest.approx(lmi.value, rel=1e-5)
+
+
+@pytest.mark.parametrize("blocks", [
+    [Block.scalar(2), Block.full(1), Block.full(2)],          # repeated complex scalar
+    [Block.scalar(3), Block.scalar(1), Block.full(1, 2)],
+    [Block.real(2), Block.scalar(2), Block.full(1, 2)],       # repeated real scalar: LMI after
+    [Block.real(2), Block.full(1), Block.real()],
+], ids=["C2-F1-F2", "C3-C1-F1x2", "R2-C2-F1x2", "R2-F1-R1"])
+def test_default_equals_lmi_where_ab13md_does_not_apply(blocks):
+    S = BlockStructure(blocks)
+    rng = np.random.default_rng(len(S) + S.nrows)
+    for variant in range(2):
+        M = _matrix(rng, S, variant)
+        up = mu_upper(M, S)
+        lmi = mu_upper(M, S, method="lmi")
+        _certified(M, S, up)
+        _certified(M, S, lmi)
+        assert up.value <= lmi.value * (1 + 1e-6)
+        assert up.value >= lmi.lower_level * (1 - 1e-6)
+
+
+def test_lmi_route_still_agrees_and_is_selectable():
+    ab13md = pytest.importorskip("slycot").ab13md
+    S, nb, it = ab13md_structure(["real", "c1", "full2"])
+    M = crandn(np.random.default_rng(5), S.ncols, S.nrows)
+    lmi, auto = mu_upper(M, S, method="lmi"), mu_upper(M, S)
+    assert lmi.method == "lmi-dg" and auto.method == "fast-dg"
+    assert lmi.value == pytest.approx(ab13md(M, nb, it)[0], rel=1e-5)
+    assert lmi.value == pytest.approx(auto.value, rel=1e-5)
+    assert mu_upper(M, S, method="osborne").method == "osborne"
+    assert mu_bounds(M, S).upper.method == "fast-dg"
+    assert mu_bounds(M, S, method="lmi").upper.method == "lmi-dg"
+
+
+def test_default_needs_no_sdp(monkeypatch):
+    # no LMI (cvxpy) on the default path for structures the descent handles
+    def no_lmi(*args, **kw):
+        raise AssertionError("the LMI was built")
+    monkeypatch.setattr(lmi_module, "_lmi_problem", no_lmi)
+    S, _, _ = ab13md_structure(["real", "real", "c1", "full2"])
+    M = crandn(np.random.default_rng(8), S.ncols, S.nrows)
+    up = mu_upper(M, S)
+    _certified(M, S, up)
+    with pytest.raises(AssertionError, match="LMI was built"):
+        mu_upper(M, S, method="lmi")
+
+
+def test_failed_certificate_falls_back_to_the_lmi(monkeypatch):
+    S, _, _ = ab13md_structure(["real", "c1", "full2"])
+    M = crandn(np.random.default_rng(9), S.ncols, S.nrows)
+    good = mu_upper(M, S)
+    real_fast = upper_module._fast_default
+
+    def wrong(*args, **kw):
+        up, x = real_fast(*args, **kw)
+        up.value *= 0.9                      # a value its scalings do not certify
+        return up, x
+    monkeypatch.setattr(upper_module, "_fast_default", wrong)
+    up = mu_upper(M, S)
+    assert up.method == "lmi-dg"
+    _certified(M, S, up)
+    assert up.value == pytest.approx(good.value, rel=1e-5)
+
+
+def _random_stable(rng, n, p, m):
+    A = rng.standard_normal((n, n))
+    A -= (np.linalg.eigvals(A).real.max() + 0.3) * np.eye(n)
+    return ss(A, rng.standard_normal((n, m)), rng.standard_normal((p, n)), rng.standard_normal((p, m)))
+
+
+@pytest.mark.parametrize("plant", [
+    (3, 4, ["real", "real", "c1", "c1"], np.logspace(-1, 1, 40)),
+    (11, 6, ["real", "c1", "full2", "real"], np.logspace(-1.5, 1.5, 60)),
+], ids=["4-states-r1r1c1c1", "6-states-r1c1F2r1"])
+def test_default_sweep_peak_equals_ab13md(plant):
+    ab13md = pytest.importorskip("slycot").ab13md
+    seed, n, kinds, omega = plant
+    S, nb, it = ab13md_structure(kinds)
+    sys = _random_stable(np.random.default_rng(seed), n, S.ncols, S.nrows)
+    H = freqresp(sys, omega)
+    ref = np.array([ab13md(H[:, :, k], nb, it)[0] for k in range(omega.size)])
+    sw = mu_sweep(sys, S, omega, lower="none", refine=False)
+    assert np.array_equal(sw.omega, omega)
+    assert set(sw.methods) <= {"fast-dg", "lmi-dg"}
+    assert sw.peak_upper == pytest.approx(ref.max(), rel=1e-6)
+    assert np.all(sw.upper <= ref * 1.05)       # the grid pass stops early away from the peak
+    # the peak is certified by its scalings
+    Mp = freqresp(sys, [sw.peak_frequency])[:, :, 0]
+    assert dg_bound(Mp, S, sw.peak.Dl, sw.peak.Dr, sw.peak.G) == pytest.approx(sw.peak_upper, rel=1e-9)
+    # the LMI route's peak, from scratch at the same frequency, agrees
+    lmi = mu_upper(Mp, S, method="lmi")
+    assert lmi.value == pytest.approx(sw.peak_upper, rel=1e-5)
