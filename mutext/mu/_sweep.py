@@ -124,6 +124,8 @@ _LOW_BAND = 0.5
 #: fast sweep: a value this fraction above both neighbours is a spike, redone from their
 #: scalings (at most _SPIKE_MAX, the largest first)
 _SPIKE, _SPIKE_MAX = 1e-3, 12
+#: fast sweep: spikes this fraction above both neighbours are redone wherever they are
+_STEEP = 0.05
 #: fast sweep: values within this fraction of the largest are polished
 _POLISH_BAND = 0.01
 #: at most this many points polished, and this many LMI checks
@@ -146,19 +148,26 @@ def _fast_peaks(res, coords, response, S: BlockStructure, params: _DGParams, cer
     """
     # a descent that stalled shows as a spike above both neighbours: redo the largest
     # spikes from the neighbours' scalings
-    grid = sorted(res)
-    vals = np.array([res[w][0].value for w in grid])
-    spikes = [i for i in range(1, len(grid) - 1)
-              if vals[i] > (1 + _SPIKE) * max(vals[i - 1], vals[i + 1])]
-    for i in sorted(spikes, key=lambda i: -vals[i])[:_SPIKE_MAX]:
-        w = grid[i]
-        M = response([w])[:, :, 0]
-        for x0 in (coords.get(grid[i - 1]), coords.get(grid[i + 1])):
-            if x0 is None:
-                continue
-            up, x, _ = _fast_at(M, S, params, x0, None, ftol=1e-10, max_eval=2 * _GRID_EVALS)
-            if up.value < res[w][0].value and (not checked or _certify(M, S, up) is not None):
-                res[w], coords[w] = (up, res[w][1]), x
+    # two passes: a bump two points wide is a spike once its higher point is redone
+    for _pass in range(2):
+        grid = sorted(res)
+        vals = np.array([res[w][0].value for w in grid])
+        spikes = [i for i in range(1, len(grid) - 1)
+                  if vals[i] > (1 + _SPIKE) * max(vals[i - 1], vals[i + 1])]
+        # the largest spikes, and the steepest ones (a warm start lost far from the peak)
+        top_spikes = sorted(spikes, key=lambda i: -vals[i])[:_SPIKE_MAX]
+        steep = sorted((i for i in spikes if vals[i] > (1 + _STEEP) * max(vals[i - 1], vals[i + 1])),
+                       key=lambda i: -vals[i] / max(vals[i - 1], vals[i + 1]))[:_SPIKE_MAX]
+        for i in top_spikes + [i for i in steep if i not in top_spikes]:
+            w = grid[i]
+            M = response([w])[:, :, 0]
+            starts = [coords.get(grid[i - 1]), coords.get(grid[i + 1])]
+            starts = [x0 for x0 in starts if x0 is not None] + ([None] if i in steep else [])
+            for x0 in starts:
+                # (a steep spike also from a cold start: the neighbours' scalings may be as lost)
+                up, x, _ = _fast_at(M, S, params, x0, None, ftol=1e-10, max_eval=2 * _GRID_EVALS)
+                if up.value < res[w][0].value and (not checked or _certify(M, S, up) is not None):
+                    res[w], coords[w] = (up, res[w][1]), x
     ws = sorted(res, key=lambda w: -res[w][0].value)
     top = res[ws[0]][0].value
     for w in [w for w in ws if res[w][0].value >= (1 - _POLISH_BAND) * top][:_POLISH_MAX]:
