@@ -506,24 +506,31 @@ def _shafts(L=0.05, di=0.0):
             for s in range(1, 6)]
 
 
-@pytest.mark.parametrize("planes, orientation", [(1, 0.0), (1, "mean"), (2, 0.6), (2, "mean")])
-def test_crack_element_in_rotor_matches_cracked_element(planes, orientation):
+@pytest.mark.parametrize("perpendicular", [True, False])
+@pytest.mark.parametrize("planes, orientation", [(1, 0.0), (1, 0.6), (1, "mean"), (2, 0.6), (2, "mean")])
+def test_crack_element_in_rotor_matches_cracked_element(planes, orientation, perpendicular):
     from mutext.rotor import Rotor
     from mutext.rotor.elements import T_XZ, T_YZ
     L, xi, depth = 0.05, 0.3, 0.4
     healthy = Rotor(_shafts(L), planes=planes)
-    cracked = Rotor(_shafts(L) + [cr.Crack(3, depth, xi=xi, orientation=orientation)], planes=planes)
+    cracked = Rotor(_shafts(L) + [cr.Crack(3, depth, xi=xi, orientation=orientation,
+                                           perpendicular=perpendicular)], planes=planes)
     dK = cracked.matrices().K - healthy.matrices().K
     n = 2 * planes
     host = slice(2 * n, 4 * n)                   # stations 3 and 4
     c = cr.crack_compliance(depth, E, D, NU)
+    c44 = cr.crack_compliance(depth, E, D, NU, component=44) if perpendicular else 0.0
     delta = (cr.cracked_element_stiffness(L, E, I_SHAFT, c, position=xi)
              - cr.cracked_element_stiffness(L, E, I_SHAFT, 0.0))
+    delta44 = (cr.cracked_element_stiffness(L, E, I_SHAFT, c44, position=xi)
+               - cr.cracked_element_stiffness(L, E, I_SHAFT, 0.0))
     if orientation == "mean":
-        ref = delta / 2 if planes == 1 else linalg.block_diag(delta, delta) / 2
+        mean = (delta + delta44) / 2
+        ref = mean if planes == 1 else linalg.block_diag(mean, mean)
     else:
-        ref = np.cos(orientation)**2 * delta if planes == 1 else (
-            cr.cracked_element_stiffness_two_plane(L, E, I_SHAFT, c, orientation, position=xi)
+        ref = np.cos(orientation)**2 * delta + np.sin(orientation)**2 * delta44 if planes == 1 else (
+            cr.cracked_element_stiffness_two_plane(L, E, I_SHAFT, c, orientation, position=xi,
+                                                   compliance_eta=c44)
             - cr.cracked_element_stiffness_two_plane(L, E, I_SHAFT, 0.0, orientation, position=xi))
     if planes == 2:                              # plane-blocked (w, slope) -> station DOFs
         T = np.vstack([np.array(T_XZ), np.array(T_YZ)])

@@ -151,9 +151,33 @@ def _matrix(rows):
 # open crack: local flexibility from fracture mechanics
 # ----------------------------------------------------------------------------
 
+#: The two bending compliances of the crack, in the notation of [PD87]_.
+COMPONENTS = (55, 44)
+
+
+def _component(component) -> int:
+    """55 or 44 from 55, 44, "c55" or "c44"."""
+    if isinstance(component, str) and component.lower() in ("c55", "c44", "55", "44"):
+        return int(component.lower().lstrip("c"))
+    if not isinstance(component, bool) and isinstance(component, (int, np.integer)) and int(component) in COMPONENTS:
+        return int(component)
+    raise ModelError(f"component must be 55 (moment parallel to the crack edge) or 44 (moment "
+                     f"perpendicular to it), or 'c55'/'c44', got {component!r}")
+
+
+def _F1(lam, ratio):
+    # edge-cracked strip in tension ([TPI]_); ratio = alpha/h, lam = pi alpha/(2h)
+    return ca.sqrt(ca.tan(lam) / lam) * (0.752 + 2.02 * ratio + 0.37 * (1.0 - ca.sin(lam))**3) / ca.cos(lam)
+
+
+def _F2(lam):
+    # edge-cracked strip in pure bending ([TPI]_)
+    return ca.sqrt(ca.tan(lam) / lam) * (0.923 + 0.199 * (1.0 - ca.sin(lam))**4) / ca.cos(lam)
+
+
 @lru_cache(maxsize=8)
-def _cbar_function(n_quad: int) -> ca.Function:
-    r"""CasADi function :math:`\bar a \mapsto \bar c_{55}(\bar a)` (:math:`\bar a = a/R`)."""
+def _cbar_function(n_quad: int, component: int = 55) -> ca.Function:
+    r"""CasADi function :math:`\bar a \mapsto \bar c_{55}(\bar a)` or :math:`\bar c_{44}(\bar a)` (:math:`\bar a = a/R`)."""
     abar = ca.SX.sym("abar")
     xu, wu = np.polynomial.legendre.leggauss(n_quad)
     u = (xu + 1.0) * np.pi / 4.0          # u in (0, pi/2): xi = b sin u
@@ -173,54 +197,81 @@ def _cbar_function(n_quad: int) -> ca.Function:
         for sj, wj in zip(s, ws):
             y = alpha * sj
             lam = np.pi * y / (2.0 * h)
-            F2 = ca.sqrt(ca.tan(lam) / lam) * (0.923 + 0.199 * (1.0 - ca.sin(lam))**4) / ca.cos(lam)
-            inner += wj * y * F2**2
-        total += wi * dxi * alpha * (1.0 - xi**2) * inner
+            F = _F2(lam) if component == 55 else _F1(lam, y / h)
+            inner += wj * y * F**2
+        # stress on the strip: ~ sqrt(1 - xi^2) (c55, bending of the strip), ~ xi (c44, tension)
+        weight = (1.0 - xi**2) if component == 55 else xi**2
+        total += wi * dxi * alpha * weight * inner
     # symmetric in xi: twice the integral over xi in (0, b)
     cbar = 2.0 * 32.0 / np.pi * total
     # the integrand is 0/0 at zero depth: the compliance is exactly 0 there
     cbar = ca.if_else(abar > 0, cbar, 0.0, True)
-    return ca.Function("crack_cbar55", [abar], [cbar])
+    return ca.Function(f"crack_cbar{component}", [abar], [cbar])
 
 
-def crack_compliance_dimensionless(depth_ratio, *, n_quad: int = 16):
-    r"""Dimensionless bending compliance :math:`\bar c_{55}` of an open crack.
+def crack_compliance_dimensionless(depth_ratio, *, n_quad: int = 16, component=55):
+    r"""Dimensionless bending compliance :math:`\bar c_{55}` or :math:`\bar c_{44}` of an open crack.
 
     The crack is a straight-fronted transverse surface crack of depth
-    :math:`a` in a circular shaft of radius :math:`R = D/2`.  Following
-    [DP83]_ and [PD87]_, the crack is cut into strips of width :math:`d\xi`
-    parallel to the depth direction; each strip (height
-    :math:`h = 2\sqrt{R^2-\xi^2}`, local crack depth
-    :math:`\alpha_\xi = \sqrt{R^2-\xi^2} - (R-a)`) is treated as an
-    edge-cracked strip in bending with the stress-intensity factor
+    :math:`a` in a circular shaft of radius :math:`R = D/2`; :math:`\xi` is
+    the coordinate along the crack edge (from the centre line of the crack)
+    and :math:`\alpha` the depth coordinate.  Following [DP83]_ and [PD87]_,
+    the crack is cut into strips of width :math:`d\xi` parallel to the depth
+    direction; each strip (height :math:`h = 2\sqrt{R^2-\xi^2}`, local crack
+    depth :math:`\alpha_\xi = \sqrt{R^2-\xi^2} - (R-a)`) is treated as an
+    edge-cracked strip, and the additional strain energy
+    :math:`U = \frac{1-\nu^2}{E}\int_A K_I^2\,dA` (plane strain) gives the
+    compliance :math:`c = \partial^2 U/\partial M^2`.
+
+    * ``component=55``: the bending moment :math:`M_5` whose vector is
+      parallel to the crack edge (it opens the crack).  The strip is bent,
+      with the outer-fibre stress of the shaft at its ends,
+
+      .. math::
+          K_I = \sigma_5\sqrt{\pi\alpha}\,F_2(\alpha/h),\qquad
+          \sigma_5 = \frac{4M_5\sqrt{R^2-\xi^2}}{\pi R^4},\qquad
+          F_2 = \sqrt{\frac{\tan\lambda}{\lambda}}\;
+          \frac{0.923 + 0.199\,(1-\sin\lambda)^4}{\cos\lambda}.
+
+    * ``component=44``: the bending moment :math:`M_4` whose vector is
+      perpendicular to the crack edge.  The bending stress varies along the
+      edge, so each strip is loaded (nearly) in tension by the stress at its
+      distance :math:`\xi` from the neutral axis,
+
+      .. math::
+          K_I = \sigma_4\sqrt{\pi\alpha}\,F_1(\alpha/h),\qquad
+          \sigma_4 = \frac{4M_4\,\xi}{\pi R^4},\qquad
+          F_1 = \sqrt{\frac{\tan\lambda}{\lambda}}\;
+          \frac{0.752 + 2.02\,(\alpha/h) + 0.37\,(1-\sin\lambda)^3}{\cos\lambda}.
+
+    with :math:`\lambda = \pi\alpha/(2h)` ([TPI]_: single-edge-cracked strip
+    in pure bending, :math:`F_2`, and in tension, :math:`F_1`).  In the
+    variables :math:`\bar\xi = \xi/R`, :math:`\bar\alpha = \alpha/R`,
+    :math:`\bar a = a/R` ([PD87]_, [Pap04]_):
 
     .. math::
-        K_I = \sigma(\xi)\sqrt{\pi\alpha}\,F_2(\alpha/h),\qquad
-        \sigma(\xi) = \frac{4M\sqrt{R^2-\xi^2}}{\pi R^4},
-
-    .. math::
-        F_2 = \sqrt{\frac{\tan\lambda}{\lambda}}\;
-        \frac{0.923 + 0.199\,(1-\sin\lambda)^4}{\cos\lambda},\qquad
-        \lambda = \frac{\pi\alpha}{2h}
-
-    ([TPI]_, pure bending of a single-edge-cracked strip).  The additional
-    strain energy :math:`U = \frac{1-\nu^2}{E}\int_A K_I^2\,dA` (plane
-    strain) gives the compliance :math:`c = \partial^2 U/\partial M^2`, which
-    in the variables :math:`\bar\xi = \xi/R`, :math:`\bar\alpha = \alpha/R`,
-    :math:`\bar a = a/R` reads ([PD87]_, [Pap04]_)
-
-    .. math::
-        c = \frac{1-\nu^2}{E R^3}\,\bar c_{55},\qquad
+        c_{55} = \frac{1-\nu^2}{E R^3}\,\bar c_{55},\qquad
         \bar c_{55}(\bar a) = \frac{32}{\pi}\int_{-\bar b}^{\bar b}
         \int_0^{\bar\alpha_\xi} (1-\bar\xi^2)\,\bar\alpha\,
         F_2^2\!\left(\frac{\bar\alpha}{2\sqrt{1-\bar\xi^2}}\right)
         d\bar\alpha\,d\bar\xi,
 
+    .. math::
+        c_{44} = \frac{1-\nu^2}{E R^3}\,\bar c_{44},\qquad
+        \bar c_{44}(\bar a) = \frac{32}{\pi}\int_{-\bar b}^{\bar b}
+        \int_0^{\bar\alpha_\xi} \bar\xi^2\,\bar\alpha\,
+        F_1^2\!\left(\frac{\bar\alpha}{2\sqrt{1-\bar\xi^2}}\right)
+        d\bar\alpha\,d\bar\xi,
+
     with :math:`\bar b = \sqrt{1-(1-\bar a)^2}` and
-    :math:`\bar\alpha_\xi = \sqrt{1-\bar\xi^2} - (1-\bar a)`.  :math:`M` is
-    the bending moment whose vector is parallel to the crack edge, i.e. the
-    moment that opens the crack; it is the dominant term of the crack
-    compliance matrix.
+    :math:`\bar\alpha_\xi = \sqrt{1-\bar\xi^2} - (1-\bar a)`.  (Some authors
+    tabulate :math:`\pi\bar c`; the normalisation here has no :math:`\pi`.)
+    :math:`c_{55}` is the larger: :math:`c_{44}/c_{55}` is about 0.07 at
+    :math:`a/D = 0.1`, 0.15 at 0.2, 0.26 at 0.3, 0.42 at 0.4 and 0.68 at
+    0.5.  The crack's narrow width (:math:`2b \approx 2\sqrt{aD}`) puts
+    little of it far from the neutral axis of :math:`M_4`, so for shallow
+    cracks :math:`\bar c_{55} \propto \bar a^{5/2}` but
+    :math:`\bar c_{44} \propto \bar a^{7/2}`.
 
     The double integral is evaluated by a fixed tensor Gauss-Legendre rule
     (``n_quad`` x ``n_quad`` points) after the substitutions
@@ -228,33 +279,38 @@ def crack_compliance_dimensionless(depth_ratio, *, n_quad: int = 16):
     which make the integrand smooth up to :math:`a/D = 0.5`.  The rule is a
     fixed, smooth expression of the depth, so CasADi differentiates it
     exactly (IPOPT can tune the depth); with the default 16 points it agrees
-    with adaptive quadrature to better than 1e-9 relative over
+    with adaptive quadrature to better than 1e-9 relative for
+    :math:`\bar c_{55}` and 2e-8 for :math:`\bar c_{44}` over
     :math:`0 < a/D \le 0.5`.
 
     Parameters
     ----------
     depth_ratio : float, array_like or casadi.SX/MX scalar
         Crack depth over shaft diameter, :math:`a/D \in [0, 0.5]`.  Note the
-        integral above is written in :math:`\bar a = a/R = 2a/D`.
+        integrals above are written in :math:`\bar a = a/R = 2a/D`.
     n_quad : int
         Gauss points per direction.
+    component : {55, 44, "c55", "c44"}
+        Which compliance: 55 (moment parallel to the crack edge, default)
+        or 44 (moment perpendicular to it).
 
     Returns
     -------
     float, numpy.ndarray or casadi expression
-        :math:`\bar c_{55}` (dimensionless); 0 at zero depth.  Reference
-        values: 0.0277722 at :math:`a/D = 0.05`, 0.724880 at 0.2, 3.97355 at
-        0.4 (see the tests).
+        :math:`\bar c_{55}` or :math:`\bar c_{44}` (dimensionless); 0 at
+        zero depth.  Reference values of :math:`\bar c_{55}`: 0.0277722 at
+        :math:`a/D = 0.05`, 0.724880 at 0.2, 3.97355 at 0.4; of
+        :math:`\bar c_{44}`: 0.109043 at 0.2, 1.65513 at 0.4 (see the tests).
 
     Notes
     -----
-    For small depths :math:`\bar c_{55} \propto \bar a^{5/2}`, so the
-    derivative with respect to depth vanishes at zero depth; the expression
-    is evaluated as exactly 0 there (its derivative there is returned as 0).
+    Both vanish faster than the depth, so their derivative with respect to
+    depth vanishes at zero depth; the expression is evaluated as exactly 0
+    there (its derivative there is returned as 0).
     """
     if isinstance(n_quad, bool) or not isinstance(n_quad, (int, np.integer)) or not 1 <= n_quad <= 200:
         raise ModelError(f"n_quad must be an integer number of Gauss points in 1..200, got {n_quad!r}")
-    f = _cbar_function(int(n_quad))
+    f = _cbar_function(int(n_quad), _component(component))
     if isinstance(depth_ratio, ca.DM):
         depth_ratio = np.array(depth_ratio, dtype=float).squeeze()
     if isinstance(depth_ratio, (ca.SX, ca.MX)):
@@ -265,18 +321,23 @@ def crack_compliance_dimensionless(depth_ratio, *, n_quad: int = 16):
     return np.array([float(f(2.0 * _depth(v))) for v in arr.ravel()]).reshape(arr.shape)
 
 
-def crack_compliance(depth_ratio, E, D, nu=0.3, *, n_quad: int = 16):
+def crack_compliance(depth_ratio, E, D, nu=0.3, *, n_quad: int = 16, component=55):
     r"""Additional rotational compliance of an open crack, in rad/(N m).
 
     .. math::
-        c(a/D) = \frac{(1-\nu^2)\,\bar c_{55}(2a/D)}{E\,(D/2)^3}
+        c_{55}(a/D) = \frac{(1-\nu^2)\,\bar c_{55}(2a/D)}{E\,(D/2)^3},\qquad
+        c_{44}(a/D) = \frac{(1-\nu^2)\,\bar c_{44}(2a/D)}{E\,(D/2)^3}
 
-    with :math:`\bar c_{55}` from :func:`crack_compliance_dimensionless`
-    ([DP83]_, [PD87]_).  A bending moment :math:`M` (N m) that opens the
-    crack produces an extra relative rotation :math:`\Delta\theta = c\,M`
-    (rad) of the two faces.  For orientation: :math:`c\,EI` is the shaft
-    length with the same flexibility, about :math:`1.42\,D` for the rig crack
-    (:math:`a/D = 0.4`, :math:`\nu = 0.3`).
+    with :math:`\bar c_{55}, \bar c_{44}` from
+    :func:`crack_compliance_dimensionless` ([DP83]_, [PD87]_).  A bending
+    moment :math:`M` (N m) produces an extra relative rotation
+    :math:`\Delta\theta = c\,M` (rad) of the two faces, in the plane of the
+    moment: :math:`c_{55}` for the moment parallel to the crack edge (the one
+    that opens the crack, bending in the plane of the crack normal),
+    :math:`c_{44}` for the moment perpendicular to it.  For orientation:
+    :math:`c_{55}\,EI` is the shaft length with the same flexibility, about
+    :math:`1.42\,D` for the rig crack (:math:`a/D = 0.4`, :math:`\nu = 0.3`);
+    :math:`c_{44}\,EI` is about :math:`0.59\,D`.
 
     Parameters
     ----------
@@ -288,6 +349,8 @@ def crack_compliance(depth_ratio, E, D, nu=0.3, *, n_quad: int = 16):
         Shaft diameter at the crack [m].
     nu : float or casadi scalar
         Poisson's ratio [-] (plane-strain factor :math:`1-\nu^2`).
+    component : {55, 44, "c55", "c44"}
+        Which compliance (default 55, the moment parallel to the crack edge).
 
     Returns
     -------
@@ -300,7 +363,8 @@ def crack_compliance(depth_ratio, E, D, nu=0.3, *, n_quad: int = 16):
     if not _symbolic(nu) and not -1.0 < nu < 0.5:
         raise ModelError(f"nu (Poisson's ratio) must lie in (-1, 0.5), got {nu}")
     R = D / 2.0
-    return (1.0 - nu**2) * crack_compliance_dimensionless(depth_ratio, n_quad=n_quad) / (E * R**3)
+    cbar = crack_compliance_dimensionless(depth_ratio, n_quad=n_quad, component=component)
+    return (1.0 - nu**2) * cbar / (E * R**3)
 
 
 def crack_rotational_stiffness(depth_ratio, E, D, nu=0.3, *, n_quad: int = 16):
@@ -431,7 +495,8 @@ def cracked_element_stiffness(L, E, I, compliance, *, position=1.0, phi=0.0):
     return _matrix(K)
 
 
-def cracked_element_stiffness_two_plane(L, E, I, compliance, angle, *, position=1.0, phi=0.0):
+def cracked_element_stiffness_two_plane(L, E, I, compliance, angle, *, position=1.0, phi=0.0,
+                                        compliance_eta=0.0):
     r"""Stiffness of a cracked beam element with two bending planes (fixed frame).
 
     DOF order (blocked by plane)
@@ -440,38 +505,46 @@ def cracked_element_stiffness_two_plane(L, E, I, compliance, angle, *, position=
     :math:`s_x, s_y` the section rotations in the planes :math:`xz` and
     :math:`yz`, with :math:`s_x = dw_x/dz`, :math:`s_y = dw_y/dz` for a
     slender beam (rad).  The crack normal :math:`\xi` (from the shaft axis
-    towards the crack mouth) makes the angle ``angle`` with :math:`x`.
-    Only bending in the :math:`\xi z` plane (moment vector parallel to the
-    crack edge) sees the compliance; bending in the :math:`\eta z` plane is
-    treated as healthy: the compliance for the moment perpendicular to the
-    crack edge is neglected.  That is a modelling limitation, not a small
-    term: by the same strip integral its ratio to the one kept is about 0.07
-    at a/D = 0.1, 0.26 at 0.3, 0.42 at 0.4 and 0.68 at 0.5, so at the rig's
-    depth the mean stiffness loss is understated (by about that ratio) and
-    the twice-per-revolution asymmetry overstated (the book's rotor chapter
-    quantifies both; Papadopoulos and Dimarogonas 1987).  In the
-    crack frame the element is therefore the uncoupled pair
-    :math:`K_\xi` = :func:`cracked_element_stiffness` and :math:`K_\eta` =
-    healthy element, and with :math:`\cos, \sin` of ``angle``:
+    towards the crack mouth) makes the angle ``angle`` with :math:`x`;
+    :math:`\eta` is along the crack edge.  Bending in the :math:`\xi z`
+    plane (moment vector parallel to the crack edge) sees ``compliance``
+    (:math:`c_{55}`), bending in the :math:`\eta z` plane (moment vector
+    perpendicular to the edge) sees ``compliance_eta`` (:math:`c_{44}`,
+    :func:`crack_compliance` with ``component=44``).  In the crack frame the
+    element is the uncoupled pair :math:`K_\xi` =
+    :func:`cracked_element_stiffness` with :math:`c_{55}` and :math:`K_\eta`
+    = the same element with :math:`c_{44}`; with :math:`\cos, \sin` of
+    ``angle``:
 
     .. math::
         K = \begin{bmatrix} \cos^2 K_\xi + \sin^2 K_\eta &
         \cos\sin\,(K_\xi-K_\eta) \\ \cos\sin\,(K_\xi-K_\eta) &
         \sin^2 K_\xi + \cos^2 K_\eta \end{bmatrix}.
 
+    ``compliance_eta = 0`` (the default of this low-level function, which
+    is given compliances, not a depth) treats the :math:`\eta z` plane as
+    healthy: the one-compliance model.  That neglect is not small for deep
+    cracks: :math:`c_{44}/c_{55}` is about 0.07 at a/D = 0.1, 0.26 at 0.3,
+    0.42 at 0.4 and 0.68 at 0.5, and to first order the mean stiffness loss
+    grows with :math:`c_{55}+c_{44}` while the twice-per-revolution
+    asymmetry grows with :math:`c_{55}-c_{44}` ([PD87]_).  The assembled
+    :class:`Crack` includes :math:`c_{44}` by default.
+
     For a breathing crack in a finite-element rotor use
-    ``compliance = open_fraction(psi) * c`` and ``angle = Omega t + angle0``
-    (compliance form of the breathing models).  Parameters as in
-    :func:`cracked_element_stiffness`; ``angle`` in rad.
+    ``compliance = open_fraction(psi) * c55``,
+    ``compliance_eta = open_fraction(psi) * c44`` and
+    ``angle = Omega t + angle0`` (compliance form of the breathing models).
+    Parameters as in :func:`cracked_element_stiffness`; ``angle`` in rad,
+    ``compliance_eta`` in rad/(N m).
 
     Returns
     -------
     (8, 8) numpy.ndarray or casadi matrix
     """
     Kx = cracked_element_stiffness(L, E, I, compliance, position=position, phi=phi)
-    Kh = cracked_element_stiffness(L, E, I, 0.0, position=position, phi=phi)
+    Kh = cracked_element_stiffness(L, E, I, compliance_eta, position=position, phi=phi)
     ang = _scalar(angle, "angle")
-    if _symbolic(ang, Kx):
+    if _symbolic(ang, Kx, Kh):
         co, si = ca.cos(ang), ca.sin(ang)
         Kx = Kx if _symbolic(Kx) else ca.DM(Kx)
         Kh = Kh if _symbolic(Kh) else ca.DM(Kh)
@@ -682,16 +755,24 @@ def _make_crack_class():
         the assembled :math:`K(p)` is a CasADi function of it with exact
         derivatives.  The mass matrix is unchanged.
 
-        Orientation (two-plane rotor): only bending across the crack edge sees
-        the compliance.  With the crack normal at angle :math:`\beta` from
-        :math:`x`, the plane changes are :math:`\cos^2\beta\,\Delta` (x-z),
-        :math:`\sin^2\beta\,\Delta` (y-z) and the coupling
-        :math:`\cos\beta\sin\beta\,\Delta` (see
-        :func:`cracked_element_stiffness_two_plane`).  ``orientation="mean"``
-        uses :math:`\Delta/2` in both planes without coupling: the stiffness of
-        an always-open crack averaged over a revolution, a linear stand-in for
-        a crack that turns with the shaft.  In the one-plane (x-z) layout the
-        change is :math:`\cos^2\beta\,\Delta` (or :math:`\Delta/2`).
+        Orientation (two-plane rotor).  Bending in the plane of the crack
+        normal :math:`\xi` (moment parallel to the crack edge) sees
+        :math:`c_{55}` and changes the element by :math:`\Delta_\xi`; bending
+        in the plane of the edge :math:`\eta` (moment perpendicular to the
+        edge) sees :math:`c_{44}` and changes it by :math:`\Delta_\eta`
+        (:func:`crack_compliance` with ``component=55`` and ``44``).  With the
+        crack normal at angle :math:`\beta` from :math:`x`, the plane changes
+        are :math:`\cos^2\beta\,\Delta_\xi + \sin^2\beta\,\Delta_\eta` (x-z),
+        :math:`\sin^2\beta\,\Delta_\xi + \cos^2\beta\,\Delta_\eta` (y-z) and
+        the coupling :math:`\cos\beta\sin\beta\,(\Delta_\xi - \Delta_\eta)`
+        (see :func:`cracked_element_stiffness_two_plane`).
+        ``orientation="mean"`` uses :math:`(\Delta_\xi + \Delta_\eta)/2` in
+        both planes without coupling: the stiffness of an always-open crack
+        averaged over a revolution, a linear stand-in for a crack that turns
+        with the shaft.  In the one-plane (x-z) layout the change is
+        :math:`\cos^2\beta\,\Delta_\xi + \sin^2\beta\,\Delta_\eta` (or the
+        mean).  With ``perpendicular=False``, :math:`\Delta_\eta = 0` (the
+        one-compliance model used before :math:`c_{44}` was added).
 
         Parameters
         ----------
@@ -705,7 +786,14 @@ def _make_crack_class():
         xi : float
             Crack position as a fraction of the host element, in [0, 1].
         n_quad : int
-            Gauss points of the compliance integral.
+            Gauss points of the compliance integrals.
+        perpendicular : bool
+            Include the compliance :math:`c_{44}` for the moment perpendicular
+            to the crack edge (default ``True``).  ``False`` keeps only
+            :math:`c_{55}` and treats bending in the plane of the crack edge as
+            healthy: the earlier model, kept for comparison.  Under-estimates
+            the mean stiffness loss and over-estimates the asymmetry of a
+            deep crack (:math:`c_{44}/c_{55} \approx 0.42` at a/D = 0.4).
         breathing : {None, "open", "mayes", "gasch"}
             A crack that turns with the shaft (see :mod:`mutext.rotor.periodic`):
             ``orientation`` is then the angle of the crack normal from :math:`x`
@@ -727,7 +815,8 @@ def _make_crack_class():
         FIELDS = {"depth_ratio": ("1", "crack depth over shaft diameter a/D")}
 
         def __init__(self, station: int, depth_ratio, *, orientation=0.0, xi: float = 0.0,
-                     n_quad: int = 16, breathing: str | None = None, name: str | None = None):
+                     n_quad: int = 16, perpendicular: bool = True, breathing: str | None = None,
+                     name: str | None = None):
             Element.__init__(self, (station, station + 1), name, depth_ratio=depth_ratio)
             if breathing is not None and breathing not in BREATHING_LAWS:
                 raise ModelError(f"{self.name}: breathing must be one of {', '.join(BREATHING_LAWS)}, "
@@ -752,6 +841,11 @@ def _make_crack_class():
                 raise ModelError(f"{self.name}: n_quad must be an integer number of Gauss points in 1..200, "
                                  f"got {n_quad!r}")
             self.n_quad = int(n_quad)
+            if not isinstance(perpendicular, (bool, np.bool_)):
+                raise ModelError(f"{self.name}: perpendicular must be true or false (include the "
+                                 f"compliance c44 for the moment perpendicular to the crack edge), "
+                                 f"got {perpendicular!r}")
+            self.perpendicular = bool(perpendicular)
             self.host = None
 
         def bind(self, structure):
@@ -763,38 +857,64 @@ def _make_crack_class():
                                  f"element '{self.host.name}' has inner diameter "
                                  f"{self.host.nominal('di'):g} m")
 
-        def compliance(self, p):
-            """Crack compliance [rad/(N m)] as an expression of the parameters ``p``."""
+        def compliance(self, p, component=55):
+            """Crack compliance ``c55`` (default) or ``c44`` [rad/(N m)] as an expression of ``p``."""
             h = self.host
             E, D = h.sym(p, "E"), h.sym(p, "do")
             nu = h.sym(p, "nu") if h.has("nu") else E / (2.0 * h.sym(p, "G")) - 1.0
-            return crack_compliance(self.sym(p, "depth_ratio"), E, D, nu, n_quad=self.n_quad)
+            return crack_compliance(self.sym(p, "depth_ratio"), E, D, nu, n_quad=self.n_quad,
+                                    component=component)
+
+        def crack_frame_deltas(self, p):
+            r"""Plane changes :math:`(\Delta_\xi, \Delta_\eta)` (4x4) of the host element for
+            bending in the plane of the crack normal (:math:`c_{55}`) and of the crack edge
+            (:math:`c_{44}`); :math:`\Delta_\eta` is ``None`` with ``perpendicular=False``."""
+            d_xi = self.plane_delta(p, self.compliance(p, 55))
+            d_eta = self.plane_delta(p, self.compliance(p, 44)) if self.perpendicular else None
+            return d_xi, d_eta
+
+        @staticmethod
+        def _rotated(d_xi, d_eta, co, si):
+            """Two-plane change of the crack whose normal has direction cosines (co, si)."""
+            out = (co**2 * ca.mtimes([T_XZ.T, d_xi, T_XZ]) + si**2 * ca.mtimes([T_YZ.T, d_xi, T_YZ])
+                   + co * si * (ca.mtimes([T_XZ.T, d_xi, T_YZ]) + ca.mtimes([T_YZ.T, d_xi, T_XZ])))
+            if d_eta is None:
+                return out
+            return (out + si**2 * ca.mtimes([T_XZ.T, d_eta, T_XZ]) + co**2 * ca.mtimes([T_YZ.T, d_eta, T_YZ])
+                    - co * si * (ca.mtimes([T_XZ.T, d_eta, T_YZ]) + ca.mtimes([T_YZ.T, d_eta, T_XZ])))
 
         def directional_deltas(self, p, layout):
             r"""Local :math:`(A_{xx}, A_{yy}, A_{xy})`: the open crack facing :math:`x`, facing
             :math:`y`, and the coupling, so that the crack at angle :math:`\beta` adds
-            :math:`\cos^2\beta A_{xx} + \sin^2\beta A_{yy} + \sin\beta\cos\beta A_{xy}`."""
+            :math:`\cos^2\beta A_{xx} + \sin^2\beta A_{yy} + \sin\beta\cos\beta A_{xy}`:
+            :math:`A_{xx} = \Delta_\xi` in x-z and :math:`\Delta_\eta` in y-z,
+            :math:`A_{yy}` the other way round, :math:`A_{xy}` the coupling of
+            :math:`\Delta_\xi - \Delta_\eta`."""
             if layout.kind != "rotor":
                 raise ModelError(f"{self.name}: a turning crack needs two bending planes (planes = 2)")
-            delta = self.plane_delta(p, self.compliance(p))
-            return (ca.mtimes([T_XZ.T, delta, T_XZ]), ca.mtimes([T_YZ.T, delta, T_YZ]),
-                    ca.mtimes([T_XZ.T, delta, T_YZ]) + ca.mtimes([T_YZ.T, delta, T_XZ]))
+            d_xi, d_eta = self.crack_frame_deltas(p)
+            Axx, Ayy = ca.mtimes([T_XZ.T, d_xi, T_XZ]), ca.mtimes([T_YZ.T, d_xi, T_YZ])
+            Axy = ca.mtimes([T_XZ.T, d_xi, T_YZ]) + ca.mtimes([T_YZ.T, d_xi, T_XZ])
+            if d_eta is None:
+                return Axx, Ayy, Axy
+            return (Axx + ca.mtimes([T_YZ.T, d_eta, T_YZ]), Ayy + ca.mtimes([T_XZ.T, d_eta, T_XZ]),
+                    Axy - ca.mtimes([T_XZ.T, d_eta, T_YZ]) - ca.mtimes([T_YZ.T, d_eta, T_XZ]))
 
         def stiffness_matrix(self, p, layout):
             if self.breathing is not None:
                 c0 = breathing_fourier(self.breathing, 0)[0].real
                 Axx, Ayy, Axy = self.directional_deltas(p, layout)
                 return float(c0[0]) * Axx + float(c0[1]) * Ayy + float(c0[2]) * Axy
-            delta = self.plane_delta(p, self.compliance(p))
+            d_xi, d_eta = self.crack_frame_deltas(p)
             if self.orientation == "mean":
+                mean = 0.5 * d_xi if d_eta is None else 0.5 * (d_xi + d_eta)
                 if layout.kind == "plane":
-                    return 0.5 * delta
-                return ca.mtimes([T_XZ.T, 0.5 * delta, T_XZ]) + ca.mtimes([T_YZ.T, 0.5 * delta, T_YZ])
+                    return mean
+                return ca.mtimes([T_XZ.T, mean, T_XZ]) + ca.mtimes([T_YZ.T, mean, T_YZ])
             co, si = float(np.cos(self.orientation)), float(np.sin(self.orientation))
             if layout.kind == "plane":
-                return co**2 * delta
-            return (co**2 * ca.mtimes([T_XZ.T, delta, T_XZ]) + si**2 * ca.mtimes([T_YZ.T, delta, T_YZ])
-                    + co * si * (ca.mtimes([T_XZ.T, delta, T_YZ]) + ca.mtimes([T_YZ.T, delta, T_XZ])))
+                return co**2 * d_xi if d_eta is None else co**2 * d_xi + si**2 * d_eta
+            return self._rotated(d_xi, d_eta, co, si)
 
     Crack.__module__ = __name__
     return Crack
