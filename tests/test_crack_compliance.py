@@ -143,7 +143,8 @@ def test_perpendicular_false_is_the_one_compliance_model(planes, orientation):
     new, old = (np.asarray(m.full()) for m in fn(rotor.values()))
     assert np.abs(new - old).max() <= 4 * np.finfo(float).eps * np.abs(old).max()
     # the full model differs, by the c44 compliance
-    full = Rotor(_shafts() + [cr.Crack(3, 0.4, xi=0.3, orientation=orientation)], planes=planes)
+    full = Rotor(_shafts() + [cr.Crack(3, 0.4, xi=0.3, orientation=orientation, perpendicular=True)],
+                 planes=planes)
     fe = full.elements[-1]
     kf = np.asarray(ca.Function("k", [full.p], [fe.stiffness_matrix(full._ps.symbols, full.layout)])(
         full.values()).full())
@@ -177,7 +178,7 @@ def test_two_plane_element_default_is_the_one_compliance_element():
 def test_directional_deltas_agree_with_the_open_crack_at_any_angle():
     from mutext.rotor import Rotor
     beta = 1.1
-    rotor = Rotor(_shafts() + [cr.Crack(3, 0.35, xi=0.5, orientation=beta)], planes=2)
+    rotor = Rotor(_shafts() + [cr.Crack(3, 0.35, xi=0.5, orientation=beta, perpendicular=True)], planes=2)
     el = rotor.elements[-1]
     p = rotor._ps.symbols
     Axx, Ayy, Axy = el.directional_deltas(p, rotor.layout)
@@ -191,7 +192,11 @@ def test_perpendicular_flag_is_checked_and_read_from_a_model_file():
     with pytest.raises(ModelError, match="perpendicular"):
         cr.Crack(3, 0.2, perpendicular="no")
     text = open(data_path("rotor.toml")).read()
-    m = loads_model(text + "\n[[crack]]\nstation = 15\ndepth_ratio = 0.4\nperpendicular = false\n",
+    m = loads_model(text + "\n[[crack]]\nstation = 15\ndepth_ratio = 0.4\nperpendicular = true\n",
+                    source="rotor.toml + crack", base_dir=data_path(""))
+    assert m.elements[-1].perpendicular is True
+    # the default is the one-compliance model the book and the exercises were computed with
+    m = loads_model(text + "\n[[crack]]\nstation = 15\ndepth_ratio = 0.4\n",
                     source="rotor.toml + crack", base_dir=data_path(""))
     assert m.elements[-1].perpendicular is False
 
