@@ -30,13 +30,21 @@ from .errors import IllPosedError, ModelError
 __all__ = [
     "ss", "as_ss", "check_finite", "mck_to_ss", "star", "lft_lower", "lft_upper",
     "lft_matrix", "freqresp", "sigma_max", "hinf_norm", "HinfNorm",
-    "balance_states", "is_stable", "stability", "Stability", "closed_loop_poles",
+    "balance_states", "is_stable", "stability", "Stability", "closed_loop_poles", "is_real_number",
 ]
 
 
 # ----------------------------------------------------------------------------
 # construction and checks
 # ----------------------------------------------------------------------------
+
+def is_real_number(x) -> bool:
+    """``x`` is a real number (int, float or their numpy kinds), not a bool, a string or an array.
+
+    The check in front of every scalar option (tolerances, margins, weights): what it lets through is
+    then tested for finiteness and range by the caller, which names the option in its error."""
+    return not isinstance(x, (bool, np.bool_)) and isinstance(x, (int, float, np.integer, np.floating))
+
 
 def blas_single_thread():
     """Context manager limiting BLAS/LAPACK to one thread (threadpoolctl).
@@ -630,8 +638,7 @@ def stability(sys, margin: float = 0.0) -> Stability:
         The verdict (truthy when stable), the poles, their thresholds and a
         message naming the deciding pole.
     """
-    if isinstance(margin, bool) or not isinstance(margin, (int, float, np.integer, np.floating)) \
-            or not np.isfinite(margin) or margin < 0:
+    if not is_real_number(margin) or not np.isfinite(margin) or margin < 0:
         raise ModelError(f"stability: margin must be a finite number >= 0 (rad/s), got {margin!r}")
     sys = as_ss(sys)
     if sys.nstates == 0:
@@ -800,8 +807,7 @@ def hinf_norm(sys, rtol: float = 1e-10, *, require_stable: bool = True) -> HinfN
     ``D`` (an exact rescaling), so systems scaled by 1e-160 or 1e300 give their
     norm, not an overflow; a norm beyond the largest double is ``inf``.
     """
-    if isinstance(rtol, bool) or not isinstance(rtol, (int, float, np.integer, np.floating)) \
-            or not np.isfinite(rtol) or not 0 < rtol < 1:
+    if not is_real_number(rtol) or not np.isfinite(rtol) or not 0 < rtol < 1:
         raise ModelError(f"hinf_norm: rtol must be a number between 0 and 1 (exclusive), got {rtol!r}")
     sys = as_ss(sys)
     check_finite(sys)

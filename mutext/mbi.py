@@ -55,7 +55,7 @@ import numpy as np
 
 from .errors import IllPosedError, InfeasibleError, ModelError, SolverError
 from .frfit import MagnitudeFit, fit_envelope
-from .lti import as_ss, check_finite, freqresp, is_stable, lft_lower, ss
+from .lti import as_ss, check_finite, freqresp, is_real_number, is_stable, lft_lower, ss
 from .mu import Block, BlockStructure
 from .response import FRF, frequency_grid
 
@@ -186,12 +186,10 @@ def mbi_plant(true, engineering, *, excitation: str, measurement: str, control_i
         responses, which must exist).
     """
     for name, v in (("Ww", Ww), ("Wz", Wz)):
-        if isinstance(v, bool) or not isinstance(v, (int, float, np.integer, np.floating)) \
-                or not np.isfinite(v) or v <= 0:
+        if not is_real_number(v) or not np.isfinite(v) or v <= 0:
             raise ModelError(f"{name} must be positive and finite, got {v!r}")
     if regularization is not None and (
-            isinstance(regularization, bool) or not isinstance(regularization, (int, float, np.integer, np.floating))
-            or not np.isfinite(regularization) or regularization < 0):
+            not is_real_number(regularization) or not np.isfinite(regularization) or regularization < 0):
         raise ModelError(f"regularization must be a finite number >= 0 (or None for none), got {regularization!r}")
     if Wz_shape is not None and not isinstance(Wz_shape, MagnitudeFit):
         raise ModelError("Wz_shape must be a mutext.frfit.MagnitudeFit (e.g. from spread_weight), "
