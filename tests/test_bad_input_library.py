@@ -146,3 +146,25 @@ def test_identify_names_an_unknown_dk_option():
     from mutext.mbi import identify
     with pytest.raises(ModelError, match="unknown option.*'bogus'"):
         identify(**tm.mbi_arguments(tm.TRIALS["1a"]), dk_options={"bogus": 1}, max_tries=1)
+
+
+@pytest.mark.parametrize("override, words", [
+    ({"bearing2.k": -1e8}, ["bearing2.k", "non-negative", "-1e+08"]),
+    ({"bearing2.c": float("nan")}, ["bearing2.c", "finite"]),
+    ({"bearing2.k": "abc"}, ["bearing2.k", "number"]),
+    ({"shaft1.L": 0.0}, ["shaft1.L", "positive"]),
+])
+def test_values_set_through_values_obey_the_model_files_rules(override, words):
+    # the model file refuses a negative bearing stiffness at parse; the same value set through
+    # values= must be refused too, not turned into a rotor that grows without bound
+    from mutext.examples.cracked_rotor import healthy_rotor
+    model = healthy_rotor()
+    with pytest.raises(ModelError) as err:
+        model.matrices(override)
+    for w in words:
+        assert w in str(err.value)
+    v = model.values()
+    v[model.parameter_names.index(next(iter(override)))] = -1.0
+    with pytest.raises(ModelError, match="must be"):
+        model.matrices(v)
+    assert np.all(np.isfinite(model.matrices({"bearing2.k": 0.0}).K))   # zero is allowed for a bearing

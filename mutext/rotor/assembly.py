@@ -195,6 +195,19 @@ class Structure:
         self.parameter_names: list[str] = ps.names
         self.nominal = np.array([q.value for q in self.parameters], dtype=float)
         self._index = {n: i for i, n in enumerate(self.parameter_names)}
+        # parameters whose sign the elements restrict (a bearing's stiffness, a mass): values set
+        # through ``values=`` are held to the same rule as the model file's
+        self._sign_rules: dict[int, tuple[bool, str]] = {}
+        for el in self.elements:
+            for f, allow_zero in getattr(el, "_sign_rules", {}).items():
+                if el.has(f):
+                    i = self._index[el.param_name(f)]
+                    old = self._sign_rules.get(i)
+                    self._sign_rules[i] = (allow_zero and (old is None or old[0]), f"{el.name}.{f}")
+        self._ruled = np.zeros(self.nominal.size, bool)
+        self._strict = np.zeros(self.nominal.size, bool)
+        for i, (allow_zero, _) in self._sign_rules.items():
+            self._ruled[i], self._strict[i] = True, not allow_zero
         p = ps.symbols
         self.p = ps.vector
 
@@ -281,13 +294,44 @@ class Structure:
             return self.nominal.copy()
         if isinstance(values, Mapping):
             v = self.nominal.copy()
+            changed = []
             for k, x in values.items():
-                v[self._lookup(k)] = float(x)
+                i = self._lookup(k)
+                try:
+                    v[i] = float(x)
+                except (TypeError, ValueError):
+                    raise ModelError(f"{self.name}: parameter '{k}' must be a number, got {x!r}") from None
+                changed.append(i)
+            self._check_values(v, changed)
             return v
-        v = np.asarray(values, dtype=float).ravel()
+        try:
+            v = np.asarray(values, dtype=float).ravel()
+        except (TypeError, ValueError):
+            raise ModelError(f"{self.name}: parameter values must be numbers, got {values!r}") from None
         if v.shape != self.nominal.shape:
             raise ModelError(f"{self.name}: expected {self.nominal.size} parameter values, got {v.size}")
+        self._check_values(v, range(v.size))
         return v
+
+    def _check_values(self, v: np.ndarray, indices) -> None:
+        """Named error for a value that is not finite or breaks its element's sign rule."""
+        idx = np.asarray(list(indices), dtype=int)
+        if idx.size == 0:
+            return
+        x = v[idx]
+        with np.errstate(invalid="ignore"):
+            bad = ~np.isfinite(x) | (self._ruled[idx] & ((x < 0) | (self._strict[idx] & (x == 0))))
+        if not bad.any():
+            return
+        i = int(idx[np.argmax(bad)])
+        x = v[i]
+        if not np.isfinite(x):
+            raise ModelError(f"{self.name}: parameter '{self.parameter_names[i]}' must be finite, got {x:g}")
+        allow_zero, where = self._sign_rules[i]
+        need = "non-negative" if allow_zero else "positive"
+        name = self.parameter_names[i]
+        where = f" ({where})" if where != name else ""
+        raise ModelError(f"{self.name}: parameter '{name}'{where} must be {need}, got {x:g}")
 
     # ------------------------------------------------------------------ numeric
     def evaluate(self, values=None):

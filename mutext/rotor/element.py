@@ -267,7 +267,10 @@ class Element:
 
 
 def _positive(el: Element, *fields, allow_zero=False):
+    # the sign rule is kept: values set later (``Structure.values``) obey it too
+    rules = el.__dict__.setdefault("_sign_rules", {})
     for f in fields:
+        rules[f] = allow_zero
         if f in el.values:
             v = el.nominal(f)
             if v < 0 or (v == 0 and not allow_zero):
