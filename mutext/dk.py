@@ -832,6 +832,7 @@ def _final_analysis(CL, S: BlockStructure, grid, final_points: int, dg: bool, np
     """Certified complex upper bound on a fine grid, lower bounds at the peaks and the D-G bound
     (refined around its own peaks).  Returns the complex sweep, the real and complex lower
     bounds, the D-G peak and the frequencies added for it."""
+    beat = report                   # no heartbeat thread when nobody listens
     report = report or (lambda stage, fraction: None)
     Sc = S.complexified()
     fine = np.unique(np.concatenate([default_grid(CL, n=final_points, decades=1.5), grid]))
@@ -842,14 +843,15 @@ def _final_analysis(CL, S: BlockStructure, grid, final_points: int, dg: bool, np
     mu_dg = float(final.peak_upper)
     wreal, extra = wpk, np.zeros(0)
     if S.has_real and dg:
-        report("final-analysis: D-G bound", 0.4)
-        mu_dg, w_dg, extra = _dg_refined_peak(CL, H, S, final.omega, ups)
+        # minutes on large loops, in one call: a heartbeat with the elapsed time
+        with _Heartbeat(beat, lambda t: f"final-analysis: D-G bound ({t:.0f} s)", 0.4):
+            mu_dg, w_dg, extra = _dg_refined_peak(CL, H, S, final.omega, ups)
         # the real lower bound also where the D-G bound peaks: a loop that uses the
         # parameters' realness has its complex peaks elsewhere
         wreal = np.union1d(wpk, [w_dg])
-    report("final-analysis: lower bounds at the peaks", 0.7)
-    low_c = mu_sweep(CL, Sc, wpk, method="osborne", lower="all", refine=False)
-    low = mu_sweep(CL, S, wreal, method="osborne", lower="all", refine=False) if S.has_real else low_c
+    with _Heartbeat(beat, lambda t: f"final-analysis: lower bounds at the peaks ({t:.0f} s)", 0.7):
+        low_c = mu_sweep(CL, Sc, wpk, method="osborne", lower="all", refine=False)
+        low = mu_sweep(CL, S, wreal, method="osborne", lower="all", refine=False) if S.has_real else low_c
     final.lower = np.full(final.omega.size, np.nan)
     final.lower[np.searchsorted(final.omega, low.omega)] = low.lower
     final.peak_lower = float(low.peak_lower)
@@ -1173,8 +1175,9 @@ def _dk(P, S, nmeas, ncon, grid, max_iter, max_order, budget, fit_tol, rel_impro
                      f"left out of the D-step grid (from {grid.min():.3g} rad/s), covered by the final "
                      f"analysis; the closed loop of the plant as given is "
                      f"{'stable' if max_re < 0 else 'NOT stable'} (largest pole real part {max_re:.3g})")
-    final, low, low_c, mu_dg, _ = _final_analysis(CL, S, grid, final_points, dg,
-                                               report=lambda stage, f: report(stage, 0.9 + 0.1 * f))
+    final, low, low_c, mu_dg, _ = _final_analysis(
+        CL, S, grid, final_points, dg,
+        report=None if on_progress is None else (lambda stage, f: report(stage, 0.9 + 0.1 * f)))
     report("final-analysis: done", 1.0)
     _print(out, f"best: iteration {best_it}, controller order {K.nstates}; fine grid: "
                 f"{low:.4f} <= mu <= {final.peak_upper:.4f}"

@@ -195,6 +195,8 @@ def test_dk_reports_progress_in_its_slow_steps(siso_dk):
     assert np.all((fractions >= 0) & (fractions <= 1))
     assert np.all(np.diff(fractions) >= -1e-12)        # overall progress never goes back
     assert stages[-1].startswith("final-analysis") and fractions[-1] == 1.0
+    # the final analysis's slow steps are announced too (with their elapsed time)
+    assert any(s.startswith("final-analysis: lower bounds at the peaks (") for s in stages)
     header = text.strip().splitlines()[0]
     assert "K order" in header and "plant" in header and "seconds" in header
     assert all(h["plant_states"] >= res.history[0]["plant_states"] for h in res.history)
