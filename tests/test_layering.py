@@ -9,7 +9,7 @@ the imports between units must not form a cycle)::
     dk, uncertain, rotor/
     mbi, rig, sysid, diagnose/, hide, uff, batch, report
     examples/
-    demos/, plots, grading/, commands/, progress
+    demos/, plots, diagrams, grading/, commands/, progress
     cli
 
 A *unit* is the first name below ``mutext`` (``mutext.rotor.crack`` is unit
@@ -34,7 +34,7 @@ LAYERS = [
     {"dk", "uncertain", "rotor"},
     {"mbi", "rig", "sysid", "diagnose", "hide", "uff", "batch", "report"},
     {"examples"},
-    {"demos", "plots", "grading", "commands", "progress"},
+    {"demos", "plots", "diagrams", "grading", "commands", "progress"},
     {"cli"},
 ]
 LAYER = {unit: k for k, units in enumerate(LAYERS) for unit in units}
