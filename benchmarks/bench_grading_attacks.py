@@ -34,10 +34,11 @@ HONEST = {"infinite_loop", "destabilizing", "missing_noise", "wrong_weight", "on
           "ex02_dmd_sign", "ex02_spectral_radius", "ex03_decrement_not_per_cycle", "ex03_hz", "ex03_thesis_eq33",
           "ex04_hz_and_pi", "ex04_lumped_mass", "ex04_missing_L", "ex04_no_supports", "ex05_hz_as_rad",
           "ex05_never_none", "ex05_unwrapped_phase", "ex05_zero_based", "ex06_centre_in_fit",
-          "ex06_fixed_threshold", "ex06_rad_per_s"}
+          "ex06_fixed_threshold", "ex06_rad_per_s", "ex07_negative_feedback", "ex07_hz", "ex07_shortcuts",
+          "ex07_stretch"}
 #: files that cheat on one question and answer the others honestly (their points come from those; the
 #: tests check that the cheated question scores 0)
-PART_CHEAT = {"cheat_in_functions", "ex02_cheat_mu", "ex04_cheat_rotor"}
+PART_CHEAT = {"cheat_in_functions", "ex02_cheat_mu", "ex04_cheat_rotor", "ex07_cheat_mu"}
 #: not submissions (helpers of the tests)
 SKIP = {"probe", "reader"}
 

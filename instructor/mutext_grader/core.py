@@ -235,6 +235,9 @@ EXERCISES = {
     "ex06_sidebands": ("mutext_grader.ex06_sidebands",
                        "cracked rotor at speed: where sidebands appear, a local sideband detector, breathing "
                        "crack, open crack or none"),
+    "ex07_small_gain": ("mutext_grader.ex07_small_gain",
+                        "M-Delta loop: M = F_l(P, K) of the two-mass springs, H-infinity norm and small-gain "
+                        "margin, least destabilising Delta, mu bounds for a diagonal structure"),
 }
 
 

@@ -608,8 +608,61 @@ EX06 = ExerciseSpec(
                   "VERDICTS.index(verdict): 0, 1 or 2", _ex06_c, float_rule(choices=(0, 1, 2)))))
 
 
+# ----------------------------------------------------------------------------------------------------------
+# ex07: the M-Delta loop and the small-gain theorem
+# ----------------------------------------------------------------------------------------------------------
+
+def _collocated_controller(rng):
+    """A first-order controller ``-(kp + kd s)/(1 + tau s)`` as an ``__ss__`` argument (no answer in it)."""
+    kp, kd, tau = _u(rng, 0.0, 100.0), _u(rng, 2.0, 20.0), _u(rng, 0.002, 0.02)
+    return _ss_arg([[-1.0 / tau]], [[1.0]], [[-(kp - kd / tau) / tau]], [[-kd / tau]])
+
+
+def _ex07_a(rng):
+    return [([_u(rng, 0.5, 3.0), _u(rng, 0.5, 3.0), _u(rng, 200.0, 800.0), _u(rng, 100.0, 600.0),
+              _u(rng, 0.05, 0.4), _u(rng, 0.05, 0.4), _collocated_controller(rng)], {}) for _ in range(2)]
+
+
+def _random_m(rng):
+    n = int(rng.integers(3, 6))
+    return _ss_arg(_stable(rng, n), rng.standard_normal((n, 2)), rng.standard_normal((2, n)), np.zeros((2, 2)))
+
+
+def _ex07_b(rng):
+    return [([_random_m(rng)], {}) for _ in range(2)]
+
+
+def _ex07_c(rng):
+    return [([_random_m(rng), _u(rng, 0.5, 50.0)], {}) for _ in range(2)]
+
+
+def _ex07_d(rng):
+    out = []
+    for _ in range(2):
+        Ms = np.stack([_complex_matrix(rng, 2) for _ in range(int(rng.integers(5, 30)))])
+        out.append(([Ms.real.tolist(), Ms.imag.tolist()], {}))
+    return out
+
+
+EX07 = ExerciseSpec(
+    "ex07_small_gain", "The M-Delta loop: small gain, destabilising Delta, structured mu",
+    "M-Delta loop: M = F_l(P, K) of the two-mass springs, H-infinity norm and small-gain margin, least "
+    "destabilising Delta, mu bounds for a diagonal structure",
+    "exercises/ex07_small_gain.py", ("mutext.mu", "mutext.uncertain", "mutext.dk", "mutext.mbi"),
+    (QuestionSpec("a", "m_delta", "the M of the M-Delta loop", 3.0, "ss",
+                  "StateSpace or (A, B, C, D), continuous time, with 2 inputs [w1, w2] and 2 outputs [z1, z2]",
+                  _ex07_a, ss_rule(2, 2)),
+     QuestionSpec("b", "small_gain", "H-infinity norm, peak frequency and small-gain margin", 2.5, "array",
+                  "array of 3 numbers [norm, omega_peak (rad/s), margin]", _ex07_b, array_rule(size=lambda a, k: 3)),
+     QuestionSpec("c", "destabilizing_delta", "least destabilising full complex Delta", 2.0, "array",
+                  "(Delta.real, Delta.imag): array of shape (2, 2, 2)", _ex07_c,
+                  array_rule(shape=lambda a, k: (2, 2, 2))),
+     QuestionSpec("d", "structured_mu", "mu bounds for the diagonal structure", 2.5, "array",
+                  "array of 2 numbers [lower, upper]", _ex07_d, array_rule(size=lambda a, k: 2))))
+
+
 #: name -> ExerciseSpec, in course order
-EXERCISES = {ex.name: ex for ex in (EX01, EX02, EX03, EX04, EX05, EX06)}
+EXERCISES = {ex.name: ex for ex in (EX01, EX02, EX03, EX04, EX05, EX06, EX07)}
 
 
 def find_exercise(name: str) -> str | None:

@@ -1,0 +1,64 @@
+"""ex07, shortcuts: (b) the norm from a coarse grid and the margin taken as the norm, (c) Delta = I / lambda, (d) the spectral radius and sigma_max as the bounds; (a) is right."""
+from __future__ import annotations
+
+import control as ct
+import numpy as np
+from scipy.optimize import minimize_scalar
+
+
+def m_delta(m1, m2, k1, k2, r1, r2, K):
+    Mm = np.diag([m1, m2])
+    K0 = np.array([[k1, -k1], [-k1, k1 + k2]])
+    b = np.array([[1.0, 0.0], [-1.0, 1.0]])            # columns b_1, b_2
+    Mi = np.linalg.inv(Mm)
+    Z, I = np.zeros((2, 2)), np.eye(2)
+    A = np.block([[Z, I], [-Mi @ K0, Z]])
+    B = np.vstack([np.zeros((2, 3)), Mi @ np.column_stack([-b, [0.0, 1.0]])])
+    C = np.vstack([np.hstack([np.diag([r1 * k1, r2 * k2]) @ b.T, Z]), [[0.0, 1.0, 0.0, 0.0]]])
+    P = ct.ss(A, B, C, np.zeros((3, 3)))
+    # the lower LFT of python-control closes the last output (y) to the last input (u) with u = K y
+    return P.lft(ct.ss(K), nu=1, ny=1)
+
+
+def small_gain(M):
+    S = ct.ss(M)
+    w = np.logspace(-1, 3, 30)                       # a coarse grid: misses the top of the peak
+    s = [np.linalg.norm(np.asarray(S(1j * wi)).reshape(2, 2), 2) for wi in w]
+    k = int(np.argmax(s))
+    return np.array([s[k], w[k], s[k]])              # and the margin taken as the norm
+
+
+def destabilizing_delta(M, omega):
+    Mj = np.asarray(ct.ss(M)(1j * float(omega)), complex).reshape(2, 2)
+    lam = np.linalg.eigvals(Mj)
+    Delta = np.eye(2) / lam[np.argmax(np.abs(lam))]  # singular, but not the least norm
+    return Delta.real, Delta.imag
+
+
+def _lower(Mj):
+    def rho(t):
+        return -np.max(np.abs(np.linalg.eigvals(Mj @ np.diag([np.exp(1j * t), 1.0]))))
+    grid = np.linspace(-np.pi, np.pi, 73)
+    vals = [rho(t) for t in grid]
+    k = int(np.argmin(vals))
+    res = minimize_scalar(rho, bounds=(grid[max(k - 1, 0)], grid[min(k + 1, grid.size - 1)]), method="bounded",
+                          options={"xatol": 1e-10})
+    return -min(res.fun, vals[k])
+
+
+def _upper(Mj):
+    def sig(x):
+        d = np.exp(x)
+        return np.linalg.norm(np.diag([d, 1.0]) @ Mj @ np.diag([1.0 / d, 1.0]), 2)
+    grid = np.linspace(-15, 15, 121)
+    vals = [sig(x) for x in grid]
+    k = int(np.argmin(vals))
+    res = minimize_scalar(sig, bounds=(grid[max(k - 1, 0)], grid[min(k + 1, grid.size - 1)]), method="bounded",
+                          options={"xatol": 1e-10})
+    return min(res.fun, vals[k])
+
+
+def structured_mu(M_re, M_im):
+    Ms = np.asarray(M_re, float) + 1j * np.asarray(M_im, float)
+    return np.array([max(np.abs(np.linalg.eigvals(Mj)).max() for Mj in Ms),
+                     max(np.linalg.norm(Mj, 2) for Mj in Ms)])   # rho and sigma_max, no search
