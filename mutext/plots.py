@@ -314,39 +314,55 @@ def mbi_figure(result, true_systems, Du=None, title=None):
     return fig
 
 
-def sideband_figure(frf, evidence, reference=None, title=None):
+def sideband_figure(frf, evidence, reference=None, title=None, band=None):
     """A measured sweep with the sideband candidates of :func:`mutext.diagnose.sideband_evidence`.
 
     Top: the magnitude (m per input unit, log scale) with ``reference`` (a
     time-invariant model's response at the same frequencies, optional), the
     modes (dotted) and each tested candidate (green where found, grey where
-    not).  Bottom: each candidate's size relative to the local response
-    against the level the noise lets the test see.
+    not), all named in the legend.  Bottom: each candidate's size relative to
+    the local response against the level the noise lets the test see.
+    ``band`` = (f_min, f_max) in Hz shows only that band (sidebands are a few
+    tenths of a percent of the response: over the whole sweep they do not show).
     """
     plt = _plt()
+    from matplotlib.lines import Line2D
     f = np.asarray(frf.freq_hz, float)
-    fig, (ax, bx) = plt.subplots(2, 1, figsize=(7.5, 6.0), sharex=True,
+    keep = np.ones(f.size, bool) if band is None else (f >= band[0]) & (f <= band[1])
+    fig, (ax, bx) = plt.subplots(2, 1, figsize=(7.0, 6.0), sharex=True,
                                  gridspec_kw={"height_ratios": [2, 1]})
-    ax.semilogy(f, np.abs(frf.response), ".", ms=2.5, color="k", label="measured")
+    ax.semilogy(f[keep], np.abs(np.asarray(frf.response)[keep]), ".", ms=2.5, color="k", label="measured")
     if reference is not None:
-        ax.semilogy(f, np.abs(reference), "-", color="C0", lw=1, label="time-invariant model")
+        ax.semilogy(f[keep], np.abs(np.asarray(reference)[keep]), "-", color="C0", lw=1,
+                    label="time-invariant model")
+    inside = (lambda x: True) if band is None else (lambda x: band[0] <= x <= band[1])
     for fm, _ in evidence.modes:
-        ax.axvline(fm, color="C0", ls=":", lw=0.8)
-    tested = [c for c in evidence.candidates if not c.masked]
+        if inside(fm):
+            ax.axvline(fm, color="C0", ls=":", lw=0.8)
+    tested = [c for c in evidence.candidates if not c.masked and inside(c.freq_hz)]
     for c in tested:
         ax.axvline(c.freq_hz, color="C2" if c.found else "0.75", lw=1.0 if c.found else 0.6)
-    ax.set_ylabel("|H|")
-    ax.legend(loc="upper right", fontsize=8)
-    ax.set_title(title or f"sidebands at {evidence.speed_hz:g} Hz running speed: {evidence.verdict}")
+    handles, _ = ax.get_legend_handles_labels()
+    handles += [Line2D([], [], color="C0", ls=":", lw=0.8, label="mode of the model"),
+                Line2D([], [], color="C2", lw=1.0, label="sideband found"),
+                Line2D([], [], color="0.75", lw=0.6, label="candidate, not found")]
+    ax.set_ylabel("|H| [m per input unit]")
+    ax.legend(handles=handles, loc="upper right", fontsize=8)
+    ax.set_title(title or f"sidebands at {evidence.speed_hz:g} Hz running speed: {evidence.verdict}",
+                 fontsize=10)
     for c in tested:
         bx.semilogy([c.freq_hz], [max(c.relative_size, 1e-6)], "o" if c.found else "x",
                     color="C2" if c.found else "0.5", ms=5)
         bx.annotate(f"{c.k:+d}", (c.freq_hz, max(c.relative_size, 1e-6)), textcoords="offset points",
-                    xytext=(3, 3), fontsize=7)
+                    xytext=(3, 3), fontsize=8)
     bx.axhline(evidence.detectable, color="C3", ls="--", lw=1, label="detectable at this noise")
+    bx.plot([], [], "o", color="C2", ms=5, label="found (order k)")
+    bx.plot([], [], "x", color="0.5", ms=5, label="not found")
     bx.set_xlabel("frequency [Hz]")
     bx.set_ylabel("sideband size / |H|")
     bx.legend(loc="upper right", fontsize=8)
+    if band is not None:
+        bx.set_xlim(*band)
     fig.tight_layout()
     return fig
 
