@@ -144,6 +144,42 @@ def _uncontrollable_modes(A, B, tol=1e-9):
     return bad
 
 
+def _axis_rank_losses(parts: PlantParts, tol: float = 1e-9) -> list[tuple[str, str]]:
+    r"""Where the Riccati route's rank conditions fail on the imaginary axis.
+
+    The central controller needs :math:`[A - j\omega I,\ B_2;\ C_1,\ D_{12}]` of full column
+    rank and :math:`[A - j\omega I,\ B_1;\ C_2,\ D_{21}]` of full row rank at every
+    :math:`\omega` (Zhou, Doyle and Glover 1996, sec. 17.1).  Checked at the frequencies where
+    they can fail: the imaginary-axis eigenvalues of :math:`A` and, for square invertible
+    :math:`D_{12}` or :math:`D_{21}`, those of :math:`A - B_2 D_{12}^{-1} C_1` or
+    :math:`A - B_1 D_{21}^{-1} C_2` (the invariant zeros).  A mode on the axis that w cannot
+    reach while it reaches y (``B1 = 0`` on that mode) is the common case."""
+    A, n = parts.A, parts.A.shape[0]
+    if n == 0:
+        return []
+    sa = max(float(np.linalg.norm(A, 2)), 1.0)
+
+    def axis(M):
+        ev = np.linalg.eigvals(M) if M.size else np.zeros(0)
+        return [lam for lam in ev if abs(lam.real) <= 1e-9 * max(abs(lam), 1e-3 * sa)]
+    out = []
+    for what, B, C, D, col in (("[A - jwI, B2; C1, D12]", parts.B2, parts.C1, parts.D12, True),
+                               ("[A - jwI, B1; C2, D21]", parts.B1, parts.C2, parts.D21, False)):
+        cands = axis(A)
+        if D.shape[0] == D.shape[1] and D.size and np.linalg.cond(D) < 1e12:
+            cands += axis(A - B @ np.linalg.solve(D, C))
+        bad = []
+        for lam in sorted({complex(round(c.real, 12), round(c.imag, 9)) for c in cands}, key=lambda c: c.imag):
+            M = np.block([[(A - lam * np.eye(n)) / sa, B], [C, D]])
+            sv = np.linalg.svd(M, compute_uv=False)
+            need = M.shape[1] if col else M.shape[0]
+            if need > min(M.shape) or sv[need - 1] < tol * max(sv[0], 1e-300):
+                bad.append(lam)
+        if bad:
+            out.append((what, ", ".join(f"s = {b.imag:+.6g}j" for b in bad)))
+    return out
+
+
 def _labels(P, kind):
     try:
         return list(P.input_labels if kind == "in" else P.output_labels)
@@ -214,6 +250,9 @@ def check_plant(P, nmeas: int, ncon: int) -> tuple[ct.StateSpace, PlantParts, li
                 "(C2, A) is not detectable: the mode(s) at s = "
                 + ", ".join(f"{b:.6g}" for b in bad)
                 + " are unstable (or on the imaginary axis) and invisible in the measurement y")
+    for what, axis in _axis_rank_losses(parts):
+        notes.append(f"{what} loses rank on the imaginary axis at {axis}: outside the Riccati method's "
+                     "assumptions; solved by the LMI route. The optimal level may only be approached.")
     r12 = np.linalg.matrix_rank(parts.D12, tol=1e-12 * max(1.0, np.abs(parts.D12).max(initial=0)))
     r21 = np.linalg.matrix_rank(parts.D21, tol=1e-12 * max(1.0, np.abs(parts.D21).max(initial=0)))
     if r12 < ncon:
@@ -1122,7 +1161,7 @@ def _level(parts: PlantParts, notes: list, solver: str, scale: bool, refine: boo
     level_method = "LMI"
     if st1 != cp.OPTIMAL:
         level_method = f"LMI (solver status {st1})"
-    regular = not any(n.startswith(("D12 does not", "D21 does not")) for n in notes)
+    regular = not any(n.startswith(("D12 does not", "D21 does not", "[A - jwI")) for n in notes)
     if regular and refine:
         g_ref = _refine_level(work0, gamma / gscale)
         if g_ref is not None and g_ref * gscale <= gamma * (1 + 1e-3):
@@ -1378,7 +1417,7 @@ def _zero_level(P, parts, nmeas, ncon, notes, solver, scale, t0):
         raise SolverError("H-infinity synthesis at the optimal level 0 (w reaches no z): the observer-based "
                           f"controller does not stabilize the closed loop ({stab.message})")
     notes = list(notes) + ["the exogenous input w reaches no performance output z for any controller "
-                           "(B1 = 0 or C1 = 0, and D11 = 0): the optimal level is 0 and any stabilizing "
+                           "(B1 = 0 and D21 = 0, or C1 = 0 and D12 = 0; D11 = 0): the optimal level is 0 and any stabilizing "
                            "controller attains it; an observer-based (LQG-type) controller is returned"]
     poles = np.linalg.eigvals(np.asarray(K.A, float)) if K.nstates else np.zeros(0)
     return HinfResult(K=K, CL=CL, gamma=0.0, gamma_target=0.0, closed_loop_norm=value,
@@ -1473,12 +1512,16 @@ def hinfsyn(P, nmeas: int, ncon: int, *, solver: str = "CLARABEL", backoff: floa
     P, parts, notes = check_plant(P, nmeas, ncon)
     if parts.n == 0:
         raise ModelError("P has no states: static H-infinity synthesis is not supported")
-    if (not np.any(parts.D11)) and (not np.any(parts.B1) or not np.any(parts.C1)):
+    # w reaches no z for any controller only when it enters nothing (B1 = 0, D21 = 0) or z reads
+    # nothing (C1 = 0, D12 = 0); with B1 = 0 alone w still enters through the measurement (D21)
+    if not np.any(parts.D11) and ((not np.any(parts.B1) and not np.any(parts.D21))
+                                  or (not np.any(parts.C1) and not np.any(parts.D12))):
         return _zero_level(P, parts, nmeas, ncon, notes, solver, scale, t0)
-    regular = not any(n.startswith(("D12 does not", "D21 does not")) for n in notes)
+    regular = not any(n.startswith(("D12 does not", "D21 does not", "[A - jwI")) for n in notes)
     if method == "riccati" and not regular:
-        raise IllPosedError("method='riccati' needs D12 of full column rank and D21 of full row rank; "
-                            + " ".join(n.split(":")[0] for n in notes if n.startswith(("D12", "D21")))
+        raise IllPosedError("method='riccati' needs D12 of full column rank, D21 of full row rank and no "
+                            "rank loss of the plant's pencils on the imaginary axis; "
+                            + "; ".join(n.split(":")[0] for n in notes if n.startswith(("D12", "D21", "[A - jwI")))
                             + " (use method='auto' or 'lmi')")
     if np.any(parts.D22):
         notes.append("D22 is nonzero: controller designed for D22 = 0 and corrected by K = K0 (I + D22 K0)^-1")

@@ -252,11 +252,12 @@ def test_natural_frequencies_bad_n(rotor, n):
 
 
 def test_negative_youngs_modulus_is_refused(rotor):
-    """A negative E gave 0.43 Hz for a statically unstable model."""
+    """A negative E gave 0.43 Hz for a statically unstable model; it is now refused where it is
+    set, with the element's rule named (as the model file refuses it)."""
     from mutext.rotor.analysis import natural_frequencies
-    with pytest.raises(IllPosedError, match="statically unstable"):
+    with pytest.raises(ModelError, match=r"'E' \(shaft\d+\.E\) must be positive"):
         natural_frequencies(rotor, values={"E": -2e11})
-    with pytest.raises(IllPosedError, match="statically unstable"):
+    with pytest.raises(ModelError, match="must be positive"):
         natural_frequencies(rotor, values={"E": -2e11}, speed=0.0)
 
 
@@ -380,3 +381,26 @@ def test_mu_upper_extreme_scaling(c):
     b = mu_bounds(M * c, S)
     assert b.upper.value == pytest.approx(ref.upper.value * c, rel=1e-6)
     assert b.lower.value <= b.upper.value * (1 + 1e-9)
+
+
+def test_hinfsyn_w_only_in_the_measurement_is_not_level_zero():
+    """B1 = 0 but D21 != 0: w enters through the measurement, so the controller carries it to z
+    and the level is not 0 (it used to be reported as 0 with an achieved norm of 1.03).  The
+    undamped mode at 1 rad/s breaks the Riccati route's rank condition; the LMI route solves it.
+    Independent bound: at the plant's pole S(j1) = 0, so the loop's T(j1) = 1 and ||T|| >= 1."""
+    import control as ct
+    from mutext.hinf import hinfsyn
+    A = np.array([[0.0, 1.0], [-1.0, 0.0]])
+    B = np.array([[0.0, 0.0], [0.0, 1.0]])                      # [B1 B2], B1 = 0
+    C = np.array([[1.0, 0.0], [0.0, 0.0], [1.0, 0.0]])          # z = (x1, u), y = x1 + w
+    D = np.array([[0.0, 0.0], [0.0, 1.0], [1.0, 0.0]])
+    res = hinfsyn(ss(A, B, C, D), 1, 1)
+    assert res.stable
+    assert res.gamma > 0.99                                     # not 0
+    assert res.closed_loop_norm_slycot == pytest.approx(res.closed_loop_norm, rel=1e-8)
+    assert res.gamma <= res.closed_loop_norm * (1 + 1e-9) <= res.gamma * (1 + 1e-4)
+    T = ct.ss(res.CL.A, res.CL.B, res.CL.C[:1], res.CL.D[:1])   # w -> x1
+    assert abs(ct.evalfr(T, 1j)) == pytest.approx(1.0, rel=1e-6)
+    assert any("loses rank on the imaginary axis" in n for n in res.notes)
+    with pytest.raises(IllPosedError, match="imaginary axis"):
+        hinfsyn(ss(A, B, C, D), 1, 1, method="riccati")
