@@ -1,0 +1,157 @@
+r"""Structural edits of a model file's TOML text that keep the user's comments and layout.
+
+A model file (:mod:`mutext.rotor.model`) is a user's document: the diagnosis
+writes what it found *into* it (a changed bearing stiffness, an added spring,
+a mass with its own spring and damper) and hands it back.  The edits are made
+on the parsed document (``tomlkit``, a round-trip TOML parser), never by
+pattern matching on the text, so a value is changed exactly in the table the
+caller selects, in any layout TOML allows (inline comments, keys in any order,
+tables of one kind not contiguous), and everything the edit does not touch --
+comments, blank lines, number formats, key order -- is written back as it
+was.  (One exception, a property of the round-trip parser: entries of one
+``[[table]]`` that stand apart in the file, another table between them, are
+written together, in their order, with their comments; the file means the
+same.)
+
+Three edits cover what :mod:`mutext.diagnose` writes:
+
+* :meth:`ModelFile.set` -- ``key = value`` in the *k*-th ``[[table]]`` a
+  predicate selects (the old value kept in a comment);
+* :meth:`ModelFile.append` -- a new ``[[table]]`` entry, with a comment line;
+* :meth:`ModelFile.scale` -- every listed key of every listed table multiplied
+  by a factor (e.g. all damping values).
+
+Every written value is a finite real number written in full precision
+(``repr`` of the float), so the model read back holds the value the caller
+gave, bit for bit.  Bad input is a :class:`~mutext.errors.ModelError` naming
+the file, the table and the key.
+"""
+from __future__ import annotations
+
+import math
+from typing import Callable
+
+import tomlkit
+from tomlkit.exceptions import TOMLKitError
+from tomlkit.items import AoT, Table
+
+from ..errors import ModelError
+
+__all__ = ["ModelFile"]
+
+
+def _number(x, where: str):
+    """A finite real number as a TOML item (bool and strings are refused)."""
+    if isinstance(x, bool) or not isinstance(x, (int, float)) or not math.isfinite(float(x)):
+        raise ModelError(f"{where}: a finite real number is needed, got {x!r}")
+    return tomlkit.item(float(x))
+
+
+class ModelFile:
+    """A model file's TOML document, edited in place; :meth:`text` gives the file back.
+
+    Parameters
+    ----------
+    text : str
+        The model file's text.
+    source : str
+        Its name in error messages.
+
+    Examples
+    --------
+    >>> mf = ModelFile('# my rig\\n[[spring]]\\nname = "k1"\\nstiffness = 800.0   # N/m\\n')
+    >>> mf.set("spring", lambda t: t["name"] == "k1", "stiffness", 820.0, "stiffened")
+    800.0
+    >>> print(mf.text())
+    # my rig
+    [[spring]]
+    name = "k1"
+    stiffness = 820.0 # N/m -- stiffened (was 800.0)
+    <BLANKLINE>
+    """
+
+    def __init__(self, text: str, source: str = "model file"):
+        self.source = source
+        try:
+            self.doc = tomlkit.parse(text)
+        except TOMLKitError as exc:
+            raise ModelError(f"{source}: not valid TOML: {exc}") from None
+
+    def entries(self, table: str) -> list:
+        """The entries of ``[[table]]`` (or the one ``[table]``) in file order; [] when absent."""
+        if table not in self.doc:
+            return []
+        t = self.doc[table]
+        if isinstance(t, (AoT, list)):
+            return list(t)
+        if isinstance(t, (Table, dict)):
+            return [t]
+        raise ModelError(f"{self.source}: '{table}' is a value, not a table")
+
+    def set(self, table: str, select: Callable[[dict], bool], key: str, value: float, note: str = "",
+            k: int = 0) -> float | None:
+        """Set ``key = value`` in the ``k``-th entry of ``[[table]]`` that ``select`` accepts.
+
+        The line gets the comment ``note (was OLD)`` after the comment it had; a key the entry does not
+        hold yet is added to it.  Returns the old value (None when added)."""
+        hits = [t for t in self.entries(table) if select(t)]
+        if len(hits) <= k:
+            raise ModelError(f"{self.source}: no [[{table}]] entry to change '{key}' in "
+                             f"({len(hits)} match the selection, entry {k + 1} asked for)")
+        t = hits[k]
+        where = f"{self.source}: [[{table}]] #{self.entries(table).index(t) + 1}, '{key}'"
+        old = t.get(key)
+        if old is not None and (isinstance(old, bool) or not isinstance(old, (int, float))):
+            raise ModelError(f"{where}: holds {old!r}, not a number that can be changed")
+        item = _number(value, where)
+        text = (note + (f" (was {old})" if old is not None else "")).strip()
+        kept = old.trivia.comment.lstrip("#").strip() if old is not None else ""
+        text = f"{kept} -- {text}" if kept and text else (kept or text)     # the user's comment first
+        if text:
+            item.comment(text)
+        t[key] = item
+        return None if old is None else float(old)
+
+    def append(self, table: str, entries: dict, note: str = "") -> None:
+        """Append a ``[[table]]`` entry holding ``entries`` (a comment line ``note`` opens it)."""
+        new = tomlkit.table()
+        if note:
+            new.add(tomlkit.comment(note))
+        for key, v in entries.items():
+            where = f"{self.source}: new [[{table}]] entry, '{key}'"
+            if isinstance(v, (str, bool, list, int)):
+                new[key] = v                # names, flags, stations and counts as given
+            else:
+                new[key] = _number(v, where)
+        new.add(tomlkit.nl())
+        new.trivia.indent = "\n"
+        if table not in self.doc:
+            self.doc.append(table, tomlkit.aot())
+        t = self.doc[table]
+        if not isinstance(t, AoT):
+            raise ModelError(f"{self.source}: '{table}' is not an array of tables ([[{table}]]): cannot add one")
+        t.append(new)
+
+    def scale(self, tables: dict, factor: float, note: str = "") -> int:
+        """Multiply every key of ``tables`` (table name -> keys) present in the file by ``factor``.
+
+        Returns how many values were scaled; a listed key holding something other than a number is a
+        :class:`~mutext.errors.ModelError`."""
+        _number(factor, f"{self.source}: scale factor")
+        count = 0
+        for table, keys in tables.items():
+            for n, t in enumerate(self.entries(table), start=1):
+                for key in keys:
+                    if key not in t:
+                        continue
+                    v = t[key]
+                    if isinstance(v, bool) or not isinstance(v, (int, float)):
+                        raise ModelError(f"{self.source}: [[{table}]] #{n}, '{key}' = {v!r} is not a plain "
+                                         "number: cannot scale it")
+                    self.set(table, lambda x, t=t: x is t, key, float(v) * factor, note)
+                    count += 1
+        return count
+
+    def text(self) -> str:
+        """The edited file's text."""
+        return tomlkit.dumps(self.doc)

@@ -1,0 +1,214 @@
+"""The model writer (mutext.rotor.model_writer) and the extended model files the diagnosis writes with it.
+
+Every kind's extended file is read back with the package's own model reader (loads_model), and the
+parameter it holds is compared with the finding's value computed here from the file's original number
+(nominal + change, or the added element's value); the original file's comments must all survive.
+"""
+from __future__ import annotations
+
+import tomllib
+
+import numpy as np
+import pytest
+
+from mutext.diagnose._extend import extended_model_text
+from mutext.diagnose._hypotheses import hypotheses
+from mutext.diagnose._result import Finding
+from mutext.errors import ModelError
+from mutext.rotor import data_path
+from mutext.rotor.model import loads_model
+from mutext.rotor.model_writer import ModelFile
+
+THREE_MASS = data_path("three_mass.toml")
+
+# a small rotor written in the file's inline form, with comments in awkward places
+ROTOR = """# a test rotor: 4 elements, disk at 3
+name = "small rotor"   # trailing comment
+[shaft]
+shear_modulus = 81.2e9
+""" + "".join("""
+[[station]]   # element
+length = 0.25
+outer_diameter = 0.05
+youngs_modulus = 211e9
+density = 7810
+""" for _ in range(4)) + """
+[[station]]
+[[disk]]
+station = 3
+mass = 8.0      # kg
+[[bearing]]
+station = 1
+stiffness = 1e6 # N/m, left
+damping = 20.0
+[[bearing]]
+station = 5
+stiffness = 2e6 # N/m, right
+damping = 0.0
+[[force]]
+station = 3
+[[sensor]]
+station = 3
+"""
+
+
+def _comments(text: str) -> list:
+    return [ln[ln.index("#"):].strip() for ln in text.splitlines() if "#" in ln]
+
+
+def test_set_keeps_every_other_line_and_comment():
+    text = ('# rig\n[[spring]]\nname = "a"\nstiffness = 1.0   # N/m\n\n'
+            '[[spring]]   # second\nname = "b"\nstiffness = 3.0   # N/m, keep\nbetween = ["m", "ground"]\n\n'
+            '[[mass]]\nname = "m"\nmass = 2\n')
+    mf = ModelFile(text)
+    assert mf.set("spring", lambda t: t["name"] == "b", "stiffness", 4.25, "changed") == 3.0
+    out = mf.text()
+    doc = tomllib.loads(out)
+    assert [s["stiffness"] for s in doc["spring"]] == [1.0, 4.25]
+    assert doc["mass"][0]["mass"] == 2
+    # only the changed line differs
+    assert len(out.splitlines()) == len(text.splitlines())
+    diff = [(a, b) for a, b in zip(text.splitlines(), out.splitlines()) if a != b]
+    assert len(diff) == 1 and diff[0][1].startswith("stiffness = 4.25") and "was 3.0" in diff[0][1]
+    assert "# N/m, keep" in diff[0][1]
+
+
+def test_tables_of_one_name_apart_in_the_file_keep_their_order_and_comments():
+    # TOML appends a later [[spring]] to the same array; the writer groups the entries (a known property
+    # of the round-trip parser) without changing what the file says
+    text = ('# rig\n[[spring]]\nname = "a"\nstiffness = 1.0   # N/m\n\n[[mass]]\nname = "m"\nmass = 2\n\n'
+            '[[spring]]   # second\nname = "b"\nstiffness = 3.0   # N/m, keep\nbetween = ["m", "ground"]\n')
+    mf = ModelFile(text)
+    mf.set("spring", lambda t: t["name"] == "b", "stiffness", 4.25, "changed")
+    a, b = tomllib.loads(text), tomllib.loads(mf.text())
+    a["spring"][1]["stiffness"] = 4.25
+    assert a == b
+    assert all(c in mf.text() for c in _comments(text))
+
+
+def test_set_adds_a_missing_key_and_values_keep_full_precision():
+    mf = ModelFile('[[bearing]]\nstation = 2\nstiffness = 1e7\n')
+    v = 1.234567890123456e-3
+    assert mf.set("bearing", lambda t: t["station"] == 2, "damping", v) is None
+    assert tomllib.loads(mf.text())["bearing"][0]["damping"] == v
+
+
+def test_append_creates_the_table_and_keeps_types():
+    mf = ModelFile('name = "x"\n[[mass]]\nname = "m1"\nmass = 1.0\n')
+    mf.append("spring", {"name": "k", "stiffness": 10.0, "between": ["m1", "ground"]}, "added spring")
+    mf.append("mass", {"name": "m2", "mass": 0.5}, "added mass")
+    out = mf.text()
+    doc = tomllib.loads(out)
+    assert doc["spring"] == [{"name": "k", "stiffness": 10.0, "between": ["m1", "ground"]}]
+    assert [m["name"] for m in doc["mass"]] == ["m1", "m2"]
+    assert "# added spring" in out and "# added mass" in out
+    mf = ModelFile("[[bearing]]\nstation = 2\n")
+    mf.append("bearing", {"station": 3, "stiffness": 1.0})
+    assert tomllib.loads(mf.text())["bearing"][1]["station"] == 3       # an int stays an int
+    assert isinstance(tomllib.loads(mf.text())["bearing"][1]["station"], int)
+
+
+def test_scale_multiplies_listed_keys_in_arrays_and_plain_tables():
+    text = ('[[damper]]\nname = "c1"\ndamping = 2.0 # N s/m\n[[damper]]\nname = "c2"\ndamping = 4\n'
+            '[damping]\nmodal = 0.01\n')
+    mf = ModelFile(text)
+    assert mf.scale({"damper": ("damping",), "damping": ("modal", "alpha")}, 1.5) == 3
+    doc = tomllib.loads(mf.text())
+    assert [d["damping"] for d in doc["damper"]] == [3.0, 6.0]
+    assert doc["damping"]["modal"] == pytest.approx(0.015, rel=1e-15)
+
+
+@pytest.mark.parametrize("text,call,match", [
+    ("[[spring\n", None, "not valid TOML"),
+    ('[[spring]]\nname = "a"\nstiffness = 1.0\n', ("set", "spring", "b"), "no \\[\\[spring\\]\\] entry"),
+    ('[[spring]]\nname = "a"\nstiffness = "soft"\n', ("set", "spring", "a"), "not a number"),
+    ('[[spring]]\nname = "a"\nstiffness = 1.0\n', ("nan", "spring", "a"), "finite real number"),
+    ('[[damper]]\nname = "a"\ndamping = true\n', ("scale", "damper", "a"), "not a plain number"),
+    ('spring = 3\n', ("append", "spring", "a"), "not an array of tables"),
+])
+def test_bad_input_gets_named_errors(text, call, match):
+    with pytest.raises(ModelError, match=match):
+        mf = ModelFile(text, source="rig.toml")
+        what, table, name = call
+        if what == "set":
+            mf.set(table, lambda t: t["name"] == name, "stiffness", 2.0)
+        elif what == "nan":
+            mf.set(table, lambda t: t["name"] == name, "stiffness", float("nan"))
+        elif what == "scale":
+            mf.scale({table: ("damping",)}, 2.0)
+        else:
+            mf.append(table, {"name": name})
+
+
+def _finding(h, value):
+    new = None if (h.added or h.gain is not None) else h.nominal + value
+    return Finding(h.kind, h.station, h.element, value, h.unit, 0.0, 0.0, 0.0, h.description, True, False, new, h)
+
+
+def _value_in_file(text, h, model):
+    """The parameter's value in the extended file, read back by the model reader."""
+    ext = loads_model(text, source="extended")
+    return float(ext.values()[ext.parameter_names.index(h.parameter)])
+
+
+def test_every_lumped_kind_is_written_and_read_back():
+    text = open(THREE_MASS, encoding="utf-8").read()
+    model = loads_model(text, source=THREE_MASS)
+    original = tomllib.loads(text)
+    hyps = [h for h in hypotheses(model) if h.gain is None and h.glob is None]
+    assert {h.kind for h in hyps} == {"stiffness", "damping", "mass"} and any(h.added for h in hyps)
+    for h in hyps:
+        value = 0.37 * h.scale
+        out = extended_model_text(text, _finding(h, value), model)
+        # the expected number from the original file (not from the model the package built)
+        table, key = {"stiffness": ("spring", "stiffness"), "damping": ("damper", "damping"),
+                      "mass": ("mass", "mass")}[h.kind]
+        old = next((t[key] for t in original.get(table, []) if t["name"] == h.element), None)
+        want = value if h.added else old + value
+        assert (old is None) == h.added
+        assert _value_in_file(out, h, model) == pytest.approx(want, rel=1e-14), h.label
+        assert all(c in out for c in _comments(text)), h.label
+
+
+def test_every_rotor_kind_is_written_and_read_back():
+    model = loads_model(ROTOR, source="small.toml")
+    original = tomllib.loads(ROTOR)
+    hyps = [h for h in hypotheses(model) if h.gain is None and h.glob is None]
+    assert {h.kind for h in hyps} == {"bearing", "stiffness", "damping", "mass", "crack"}
+    for h in hyps:
+        value = 0.21 if h.kind == "crack" else 0.37 * h.scale
+        out = extended_model_text(ROTOR, _finding(h, value), model)
+        doc = tomllib.loads(out)
+        if h.kind == "bearing":
+            key = "stiffness" if h.order == 0 else "damping"
+            old = next(b[key] for b in original["bearing"] if b["station"] == h.station)
+            new = next(b[key] for b in doc["bearing"] if b["station"] == h.station)
+            assert new == pytest.approx(old + value, rel=1e-14)
+        if h.kind == "crack":
+            assert doc["crack"] == [{"station": h.station, "depth_ratio": value}]
+        else:
+            ext = loads_model(out, source="extended")
+            names = ext.parameter_names
+            assert h.parameter in names or h.kind != "bearing", h.label
+        assert all(c in out for c in _comments(ROTOR)), h.label
+    # an added element is a new entry read back with its value, and the modes move the way it says
+    h = next(h for h in hyps if h.kind == "mass" and h.station == 2)
+    ext = loads_model(extended_model_text(ROTOR, _finding(h, 3.0), model), source="extended")
+    M0, M1 = model.matrices()[0], ext.matrices()[0]
+    dofs = h.dofs
+    dM = M1 - M0
+    assert np.allclose(dM[np.ix_(dofs, dofs)], 3.0 * np.eye(len(dofs)), rtol=1e-12)
+    dM[np.ix_(dofs, dofs)] = 0.0
+    assert np.max(np.abs(dM)) <= 1e-12 * np.max(np.abs(M0))
+
+
+def test_damping_scale_writes_every_damping_value():
+    text = open(THREE_MASS, encoding="utf-8").read()
+    model = loads_model(text, source=THREE_MASS)
+    from mutext.diagnose.faults import structure
+    h = next(h for h in structure.candidates(model) if h.glob == "damping_scale")
+    out = extended_model_text(text, _finding(h, 0.25), model)
+    a, b = tomllib.loads(text), tomllib.loads(out)
+    assert [d["damping"] * 1.25 for d in a["damper"]] == pytest.approx([d["damping"] for d in b["damper"]],
+                                                                       rel=1e-15)
+    assert all(c in out for c in _comments(text))
