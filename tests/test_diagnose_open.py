@@ -28,7 +28,6 @@ def _run(case, **kw):
 
 @pytest.mark.parametrize("example,kind,seed", [
     ("three_mass", "cubic_spring", 0),
-    ("three_mass", "tuned_absorber", 0),
     ("three_mass", "nonadjacent_spring", 1),
     ("three_mass", "wrong_model_extra_mass", 0),
     ("three_mass", "wrong_model_parameters", 0),
@@ -171,10 +170,11 @@ def test_a_size_at_the_bound_of_its_range_is_not_significant():
 
 @pytest.mark.parametrize("example,seed", [("three_mass", 0), ("four_story", 1)])
 def test_an_unmodelled_absorber_is_localised_at_its_station(example, seed, tmp_path):
-    """No hypothesis holds a tuned-mass absorber (an added degree of freedom): the diagnosis says so and
-    finds where it acts, and the report shows the impedance that station asks for."""
+    """Without the absorber kind (tests/test_diagnose_absorber.py finds it) no hypothesis holds a tuned-mass
+    absorber (an added degree of freedom): the diagnosis says so and finds where it acts, and the report
+    shows the impedance that station asks for."""
     case = make_case(example, "out_of_library", "tuned_absorber", seed, NOISE)
-    d = _run(case)
+    d = _run(case, only=lambda h: h.kind != "absorber")
     assert d.status != "explained"
     loc = d.localized
     assert loc["station"] == case.key["details"]["station"], loc["ranking"]

@@ -155,7 +155,7 @@ def test_every_lumped_kind_is_written_and_read_back():
     text = open(THREE_MASS, encoding="utf-8").read()
     model = loads_model(text, source=THREE_MASS)
     original = tomllib.loads(text)
-    hyps = [h for h in hypotheses(model) if h.gain is None and h.glob is None]
+    hyps = [h for h in hypotheses(model) if h.gain is None and h.glob is None and not h.params]
     assert {h.kind for h in hyps} == {"stiffness", "damping", "mass"} and any(h.added for h in hyps)
     for h in hyps:
         value = 0.37 * h.scale
@@ -211,4 +211,27 @@ def test_damping_scale_writes_every_damping_value():
     a, b = tomllib.loads(text), tomllib.loads(out)
     assert [d["damping"] * 1.25 for d in a["damper"]] == pytest.approx([d["damping"] for d in b["damper"]],
                                                                        rel=1e-15)
+    assert all(c in out for c in _comments(text))
+
+
+def test_an_absorber_is_written_as_a_mass_with_its_spring_and_damper():
+    text = open(THREE_MASS, encoding="utf-8").read()
+    model = loads_model(text, source=THREE_MASS)
+    h = next(h for h in hypotheses(model) if h.kind == "absorber" and h.station == 2)
+    f = _finding(h, 0.2)
+    f.values, f.stds = (0.2, 150.0, 0.5), (0.0, 0.0, 0.0)
+    out = extended_model_text(text, f, model)
+    ext = loads_model(out, source="extended")
+    n = model.layout.n_nodes
+    assert ext.layout.n_nodes == n + 1
+    M0, C0, K0, _ = model.matrices()
+    M1, C1, K1, _ = ext.matrices()
+    u = np.zeros(n + 1)
+    u[1], u[n] = 1.0, -1.0                  # host m2 (index 1), the absorber last
+    for X0, X1, v in ((K0, K1, 150.0), (C0, C1, 0.5)):
+        want = np.zeros((n + 1, n + 1))
+        want[:n, :n] = X0
+        want += v * np.outer(u, u)
+        assert np.allclose(X1, want, rtol=1e-14, atol=0)
+    assert M1[n, n] == 0.2 and np.allclose(M1[:n, :n], M0)
     assert all(c in out for c in _comments(text))

@@ -24,7 +24,8 @@ from .faults import structure as _structure
 from ._result import ChannelComparison, Diagnosis, Finding
 from ._channels import _resolve, _src
 from ._fit_quality import fit_quality, noise_reference
-from ._screen import _Data, _Evaluator, _Receptance, _fit_size, _jacobian_std, _rss, _separating_station
+from ._screen import (_Data, _Evaluator, _Receptance, _fit_size, _fit_vector, _jacobian_std, _rss,
+                      _separating_station)
 from ._select import MAX_EFFECTS, Compound, _rss_of, at_bound, fit_one_given, joint_fit
 
 log = logging.getLogger("mutext.diagnose")
@@ -183,7 +184,7 @@ def _diagnose(model, frfs, validate, alpha, refit, noise, out_dir, progress, onl
         for e in effects:
             text = extended_model_text(text, e, eng)
     if len(effects) > 1:
-        comp = [e.hypothesis for e in effects], [e.value for e in effects]
+        comp = [e.hypothesis for e in effects], [e.theta for e in effects]
         after_all = Compound(rec, all_fit, comp[0]).responses(comp[1])
         after_held = Compound(rec, held, comp[0]).responses(comp[1])
     else:
@@ -423,9 +424,11 @@ def _judge(f: Finding, N: int, threshold: float) -> None:
     does not sit at a bound of its range."""
     if f.kind == "none" or f.hypothesis is None:
         return
-    f.at_bound = bool(f.delta_chi2 > 0 and at_bound(f.hypothesis, f.value))
-    left = max(1.0, (f.score - math.log(N)) / max(N - 1, 1))
-    f.significant = bool(f.delta_chi2 / left > threshold and not f.at_bound)
+    h = f.hypothesis
+    f.at_bound = bool(f.delta_chi2 > 0 and at_bound(h, f.value if f.values is None else f.values))
+    k = h.n_params
+    left = max(1.0, (f.score - k * math.log(N)) / max(N - k, 1))
+    f.significant = bool(f.delta_chi2 / left > threshold_k(threshold, k) and not f.at_bound)
 
 
 def _status(effects, quality, gain, held_quality) -> str:
@@ -451,7 +454,8 @@ def _quality_of_file(verdict, model_text, eng, path, rec, chans, all_fit, held, 
     after_all, _ = _after(verdict, text, path, rec, chans, all_fit, held)
     with np.errstate(all="ignore"):
         r = [np.log(h / m) for h, m in zip(after_all, all_fit.meas)]
-    return fit_quality(r, all_fit.freq_hz, [c.label for c in all_fit.chans], s2, 1, ref, alpha)
+    return fit_quality(r, all_fit.freq_hz, [c.label for c in all_fit.chans], s2, verdict.hypothesis.n_params, ref,
+                       alpha)
 
 
 def _select_more(effects, hyps, rec, fit, held, s2, N, threshold, alpha, ref, notes, tell, first=None):
@@ -466,7 +470,7 @@ def _select_more(effects, hyps, rec, fit, held, s2, N, threshold, alpha, ref, no
             r = [np.log(h / m) for h, m in zip(Hs, fit.meas)]
         return fit_quality(r, fit.freq_hz, labels, s2, len(effs), ref, alpha)
 
-    thetas = [e.value for e in effects]
+    thetas = [e.theta for e in effects]
     quality = first if first is not None else quality_of(effects, thetas)
     chi_held = float(sst.chi2.isf(alpha, 1))
     while effects and not quality.at_noise and len(effects) < MAX_EFFECTS:
@@ -480,7 +484,7 @@ def _select_more(effects, hyps, rec, fit, held, s2, N, threshold, alpha, ref, no
             break
         cands = []
         for h in hyps:
-            if any(h is b for b in base):
+            if any(h is b for b in base) or h.params:      # a k-parameter kind is found first or not at all
                 continue
             t, r = fit_one_given(rec, fit, base, thetas, h)
             cands.append((r, id(h), h, t))
@@ -496,7 +500,7 @@ def _select_more(effects, hyps, rec, fit, held, s2, N, threshold, alpha, ref, no
             held_new = _rss_of(Compound(rec, held, base + [h]).responses(th), held.meas)
             dheld = (held_a - held_new) / s2
             stuck = [x.description for x, tt in zip(base + [h], th) if at_bound(x, tt)]
-            left = max(1.0, rss_new / (s2 * max(N - len(th), 1)))
+            left = max(1.0, rss_new / (s2 * max(N - sum(x.n_params for x in base + [h]), 1)))
             # an effect on one fitted file only (its scale) cannot show on other files: not held against them
             own_file_only = held_new == held_a and h.kind == "channel_scale"
             ok = dchi / left > threshold and (dheld > chi_held or own_file_only) and not stuck
@@ -512,12 +516,17 @@ def _select_more(effects, hyps, rec, fit, held, s2, N, threshold, alpha, ref, no
                          f"{len(effects)} effect(s): {why}")
             break
         new = []
+        n_par = sum(x.n_params for x in base + [h])
         for k, (x, t, d) in enumerate(zip(base + [h], th, sd)):
             old = effects[k] if k < len(effects) else None
-            new.append(Finding(x.kind, x.station, x.element, float(t), x.unit, float(d),
-                               rss_new / s2 + len(th) * math.log(N),
-                               old.delta_chi2 if old is not None else float(dchi), x.description, True, False,
-                               None if (x.gain is not None or x.added) else x.nominal + float(t), x))
+            vec = np.ndim(t) > 0
+            t0, d0 = (float(t[0]), float(d[0])) if vec else (float(t), float(d))
+            f = Finding(x.kind, x.station, x.element, t0, x.unit, d0, rss_new / s2 + n_par * math.log(N),
+                        old.delta_chi2 if old is not None else float(dchi), x.description, True, False,
+                        None if (x.gain is not None or x.added) else x.nominal + t0, x)
+            if vec:
+                f.values, f.stds = tuple(float(v) for v in t), tuple(float(v) for v in d)
+            new.append(f)
         effects, thetas = new, list(th)
         quality = quality_of(effects, thetas)
     return effects, quality
@@ -561,6 +570,12 @@ def _screen_all(hyps, rec, fit, s2, N, rss0, threshold, tell) -> list:
         if k % max(1, nh // 20) == 0:
             tell(f"screening hypotheses {k + 1}/{nh}", 0.05 + 0.6 * k / nh)
         ev = _Evaluator(rec, fit, h)
+        if h.params:                         # k > 1 parameters: a bounded least-squares fit of the vector
+            theta, rss, stds = _fit_vector(ev, s2)
+            f = _finding(h, theta[0], stds[0], rss, rss0, s2, N, threshold)
+            f.values, f.stds = tuple(float(x) for x in theta), tuple(float(x) for x in stds)
+            findings.append(f)
+            continue
         theta, rss = _fit_size(ev)
         std = _jacobian_std(ev, theta, s2) if rss < rss0 else math.inf
         findings.append(_finding(h, theta, std, rss, rss0, s2, N, threshold))
@@ -617,7 +632,7 @@ def _decide(findings, none, threshold, N, rec, fit, eng, notes, held, s2):
     ambiguous = [f for f in findings if f is not verdict and f.kind != "none" and f.significant
                  and (f.score - verdict.score) < tie]
     if ambiguous:
-        held_rss = {id(f): _rss_of(Compound(rec, held, [f.hypothesis]).responses([f.value]), held.meas)
+        held_rss = {id(f): _rss_of(Compound(rec, held, [f.hypothesis]).responses([f.theta]), held.meas)
                     for f in [verdict] + ambiguous}
         alt = min(ambiguous, key=lambda f: held_rss[id(f)])
         if (held_rss[id(verdict)] - held_rss[id(alt)]) / s2 > tie:
@@ -647,5 +662,12 @@ def _finding(h, theta, std, rss, rss0, s2, N, threshold) -> Finding:
     new = None
     if h.gain is None and not h.added:
         new = h.nominal + theta
-    return Finding(h.kind, h.station, h.element, float(theta), h.unit, float(std), rss / s2 + math.log(N),
-                   float(dchi), h.description, bool(dchi > threshold), False, new, h)
+    return Finding(h.kind, h.station, h.element, float(theta), h.unit, float(std),
+                   rss / s2 + h.n_params * math.log(N), float(dchi), h.description,
+                   bool(dchi > threshold_k(threshold, h.n_params)), False, new, h)
+
+
+def threshold_k(threshold: float, k: int) -> float:
+    """The delta chi2 threshold of a k-parameter hypothesis at the false-alarm rate of the one-parameter
+    ``threshold`` (the same tail probability of chi2 with k degrees of freedom)."""
+    return threshold if k == 1 else float(sst.chi2.isf(sst.chi2.sf(threshold, 1), k))

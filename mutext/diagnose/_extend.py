@@ -3,100 +3,44 @@ from __future__ import annotations
 
 import math
 import os
-import re
 import time
 from dataclasses import replace
-from typing import Callable
-
 from ..errors import ModelError
 from ..response import FRF
 from ..rotor.model import loads_model
+from ..rotor.model_writer import ModelFile
 from ..rotor.tuning import DB_PER_NEPER, tune
+from ._hypotheses import write_finding
 from ._result import Diagnosis, Finding
 from ._screen import _Data
 from .faults import structure as _structure
 
-def _toml_number(x: float) -> str:
-    return f"{x:.8g}" if "e" not in f"{x:.8g}" else f"{x:.8e}"
-
-
-def _replace_value(text: str, table: str, match: Callable[[dict], bool], doc_tables: list, key: str,
-                   value: float, comment: str) -> str:
-    """Set ``key = value`` in the k-th ``[[table]]`` of TOML text (the one ``match`` selects)."""
-    k = next((i for i, t in enumerate(doc_tables) if match(t)), None)
-    if k is None:
-        raise ModelError(f"cannot find the [[{table}]] entry to change in the model file")
-    lines = text.splitlines()
-    count, start = -1, None
-    for i, ln in enumerate(lines):
-        if re.match(rf"^\s*\[\[\s*{re.escape(table)}\s*\]\]", ln):
-            count += 1
-            if count == k:
-                start = i
-                break
-    if start is None:
-        raise ModelError(f"cannot locate [[{table}]] #{k + 1} in the model text")
-    for i in range(start + 1, len(lines)):
-        if re.match(r"^\s*\[", lines[i]):
-            break
-        m = re.match(rf"^(\s*{re.escape(key)}\s*=\s*)([^#]*?)(\s*(#.*)?)$", lines[i])
-        if m:
-            lines[i] = f"{m.group(1)}{_toml_number(value)}   # {comment} (was {m.group(2).strip()})"
-            return "\n".join(lines) + "\n"
-    # key absent: insert after the header
-    lines.insert(start + 1, f"{key} = {_toml_number(value)}   # {comment}")
-    return "\n".join(lines) + "\n"
-
-
 def extended_model_text(model_text: str, finding: Finding, model) -> str:
-    """The model file's text with the finding built in (a comment names the finding)."""
-    import tomllib
-    doc = tomllib.loads(model_text)
+    """The model file's text with the finding built in (a comment names the finding).
+
+    The edit is structural (:class:`mutext.rotor.model_writer.ModelFile`): the value is set in the table
+    the finding names, or a table is appended; the user's comments and layout are kept."""
     h = finding.hypothesis
     note = f"mutext diagnose: {finding.sentence()}"
     header = f"# Extended by mutext diagnose: {finding.sentence()}\n"
-    lay = model.layout
     if h is None or finding.kind == "none":
         return model_text
     if h.glob is not None:
         return header + _structure.model_text(model_text, finding, note)
     if finding.kind in ("sensor_gain", "channel_scale", "sensor_delay", "sensor_mass"):
         return header + "# (a correction of the measurement: the model itself is unchanged)\n" + model_text
-    if lay.kind == "lumped":
-        names = lay.node_names
-        if h.added:
-            tbl = "spring" if h.kind == "stiffness" else "damper"
-            key = "stiffness" if h.kind == "stiffness" else "damping"
-            return (header + model_text.rstrip("\n") + f"\n\n# {note}\n[[{tbl}]]\nname = \"{h.element}\"\n"
-                    f"{key} = {_toml_number(finding.value)}\nbetween = [\"{names[h.station - 1]}\", \"ground\"]\n")
-        if h.kind == "exciter_gain":
-            return header + "# (the force input's gain: the model itself is unchanged)\n" + model_text
-        tbl, key = {"mass": ("mass", "mass"), "stiffness": ("spring", "stiffness"),
-                    "damping": ("damper", "damping")}[h.kind]
-        new = finding.new_value
-        return header + _replace_value(model_text, tbl, lambda t: t.get("name") == h.element,
-                                       doc.get(tbl, []), key, new, note)
-    # rotors
-    if h.kind == "bearing":
-        key = "stiffness" if h.order == 0 else "damping"
-        new = finding.new_value if finding.new_value is not None else h.nominal + finding.value
-        return header + _replace_value(model_text, "bearing", lambda t: t.get("station") == h.station,
-                                       doc.get("bearing", []), key, new, note)
     if h.kind == "exciter_gain":
         st = h.gain[1]
-        port = model.inputs[st[1]] if st[0] == "port" else None
+        port = model.inputs[st[1]] if (model.layout.kind != "lumped" and st[0] == "port") else None
         if port is None:
             return header + "# (the force input's gain: the model itself is unchanged)\n" + model_text
+        mf = ModelFile(model_text)
         ki = float(model.parameter(port.gain).value) * finding.value
-        return header + _replace_value(model_text, "exciter", lambda t: t.get("station") == port.node,
-                                       doc.get("exciter", []), "force_per_ampere", ki, note)
-    add = {"stiffness": f"[[bearing]]\nname = \"{h.element}\"\nstation = {h.station}\n"
-                        f"stiffness = {_toml_number(finding.value)}\ndamping = 0.0\n",
-           "damping": f"[[bearing]]\nname = \"{h.element}\"\nstation = {h.station}\nstiffness = 0.0\n"
-                      f"damping = {_toml_number(finding.value)}\n",
-           "mass": f"[[disk]]\nname = \"{h.element}\"\nstation = {h.station}\nmass = {_toml_number(finding.value)}\n",
-           "crack": f"[[crack]]\nstation = {h.station}\ndepth_ratio = {_toml_number(finding.value)}\n"}[h.kind]
-    return header + model_text.rstrip("\n") + f"\n\n# {note}\n" + add
+        mf.set("exciter", lambda t: t.get("station") == port.node, "force_per_ampere", ki, note)
+        return header + mf.text()
+    mf = ModelFile(model_text)
+    write_finding(mf, finding, model, note)
+    return header + mf.text()
 
 
 def write_model(result: Diagnosis, out_dir) -> str | None:
@@ -158,9 +102,9 @@ def mbi_reading(model_text: str, path: str, finding: Finding, frf: FRF, excitati
     if "mass" not in doc:
         raise ModelError("model-based identification is run on lumped chains only (a rotor needs a reduced "
                          "model and minutes of D-K iteration)")
-    if h is None or h.gain is not None or len(h.dofs) != 1:
-        raise ModelError(f"a {finding.kind} finding between two masses or on a gain has no single controller "
-                         "location")
+    if h is None or h.gain is not None or len(h.dofs) != 1 or h.params:
+        raise ModelError(f"a {finding.kind} finding between two masses, on a gain or with several parameters has "
+                         "no single controller location and coefficient to compare")
     mass = doc["mass"][h.station - 1]["name"]
     text = model_text + (f'\n[[force]]\nname = "u_mbi"\nmass = "{mass}"\n'
                          f'[[sensor]]\nname = "y_mbi"\nmass = "{mass}"\n')

@@ -33,12 +33,22 @@ class Finding:
     new_value: float | None = None
     hypothesis: Hypothesis | None = field(default=None, repr=False)
     at_bound: bool = False
+    values: tuple | None = None        # k > 1 parameters (Hypothesis.params): the fitted vector ...
+    stds: tuple | None = None          # ... and the standard uncertainty of each
+
+    @property
+    def theta(self):
+        """The size as the hypothesis takes it: the value, or the vector of a k-parameter hypothesis."""
+        return self.value if self.values is None else np.asarray(self.values, float)
 
     def as_dict(self) -> dict:
         return {"kind": self.kind, "station": self.station, "element": self.element, "value": self.value,
                 "unit": self.unit, "std": self.std, "score": self.score, "delta_chi2": self.delta_chi2,
                 "description": self.description, "significant": self.significant, "refit": self.refit,
-                "new_value": self.new_value, "at_bound": self.at_bound}
+                "new_value": self.new_value, "at_bound": self.at_bound,
+                **({} if self.values is None else {
+                    "parameters": {p.name: {"value": float(v), "std": float(sd), "unit": p.unit}
+                                   for p, v, sd in zip(self.hypothesis.params, self.values, self.stds)}})}
 
     def sentence(self) -> str:
         if self.kind == "none":
@@ -51,6 +61,9 @@ class Finding:
         """The size with its unit (a factor as x1.05, a crack as a/D, a delay in ms)."""
         if self.kind == "none":
             return "-"
+        if self.values is not None:
+            return ", ".join(f"{p.name} {v:.4g}" + (f" +/- {sd:.2g}" if std else "") + f" {p.unit}"
+                             for p, v, sd in zip(self.hypothesis.params, self.values, self.stds))
         if self.kind in FACTOR_KINDS:
             return f"x{self.value:.4g}" + (f" +/- {self.std:.2g}" if std else "")
         if self.kind == "crack":

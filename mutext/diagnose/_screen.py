@@ -105,8 +105,8 @@ class _Evaluator:
                 continue
             y, z, RUU, w = piece
             nU = len(h.dofs)
-            if h.crack is not None:
-                Dt = self._D(w, theta)            # already scaled by the depth
+            if h.crack is not None or h.change is not None:
+                Dt = self._D(w, theta)            # already scaled by the depth / the parameter vector
                 scale = 1.0
             else:
                 Dt = self._D(w, 1.0)
@@ -117,7 +117,7 @@ class _Evaluator:
             H = H0 - scale * np.einsum("ku,ku->k", z, Du)
             Hs.append(H)
             if derivative:
-                if h.crack is not None:
+                if h.crack is not None or h.change is not None:
                     dHs.append(None)
                 else:
                     A2 = np.eye(nU)[None] + theta * Dt @ RUU       # I + theta D R
@@ -202,6 +202,46 @@ def _fit_size(ev: _Evaluator, n_scan: int = 25, gn_iter: int = 30):
     return t, best
 
 
+def _fit_vector(ev: _Evaluator, s2: float, n_best: int = 3):
+    """Least-squares parameter vector of a k-parameter hypothesis (all parameters positive).
+
+    The hypothesis's starting vectors are ranked by the residual; the best ``n_best`` start a bounded
+    least-squares fit in the logarithms of the parameters.  Returns ``(theta, rss, stds)``, the standard
+    uncertainties from the Jacobian at the optimum (first order: ``std_i = theta_i * std(ln theta_i)``)."""
+    import scipy.optimize as so
+    h = ev.hyp
+    meas = ev.data.meas
+    lo = np.log([p.lower for p in h.params])
+    hi = np.log([p.upper for p in h.params])
+
+    def resid(x):
+        try:
+            Hs = ev.responses(np.exp(x))
+        except np.linalg.LinAlgError:
+            return np.full(2 * ev.data.n_points, 1e3)
+        with np.errstate(all="ignore"):
+            r = np.concatenate([np.log(hh / m) for hh, m in zip(Hs, meas)])
+        r = np.concatenate([r.real, r.imag])
+        return np.where(np.isfinite(r), r, 1e3)
+
+    starts = [np.clip(np.log(np.asarray(t, float)), lo, hi) for t in h.starts]
+    ranked = sorted(((float(np.sum(resid(x) ** 2)), k) for k, x in enumerate(starts)))
+    best = None
+    for _, k in ranked[:n_best]:
+        sol = so.least_squares(resid, starts[k], bounds=(lo, hi), method="trf", x_scale=1.0, max_nfev=200)
+        rss = float(np.sum(sol.fun ** 2))
+        if best is None or rss < best[1]:
+            best = (sol.x, rss, sol.jac)
+    x, rss, J = best
+    theta = np.exp(x)
+    try:
+        cov = np.linalg.inv(J.T @ J) * s2
+        stds = theta * np.sqrt(np.maximum(np.diag(cov), 0.0))
+    except np.linalg.LinAlgError:
+        stds = np.full(theta.size, math.inf)
+    return theta, rss, stds
+
+
 def _jacobian_std(ev: _Evaluator, theta: float, s2: float) -> float:
     """Linearised standard uncertainty of the size: s * (J^T J)^{-1/2} (J from a central difference)."""
     h = ev.hyp
@@ -236,7 +276,7 @@ def _separating_station(rec: _Receptance, fit: _Data, cands: list, model) -> int
                 Rb, _ = fit.columns(rec, k)
                 H0 = Rb[:, d]
                 data = _Data([probe], [idx], [H0], [H0], [b], [fit.freq_hz[k]], {0: (Rb, rec.R[idx, d, :])})
-                hs.append(_Evaluator(rec, data, h).responses(f.value)[0])
+                hs.append(_Evaluator(rec, data, h).responses(f.theta)[0])
             resp.append(np.concatenate(hs))
         sep = min(float(np.sqrt(np.mean(np.abs(np.log(resp[i] / resp[j])) ** 2)))
                   for i in range(len(resp)) for j in range(i + 1, len(resp)))

@@ -148,45 +148,72 @@ def fit_one_given(rec, data, fixed: list, thetas: list, h):
 
 
 def joint_fit(rec, data, hyps: list, start: list, s2: float, iters: int = 40):
-    """Levenberg-Marquardt fit of all sizes at once, in bounds: (thetas, rss, stds)."""
+    """Levenberg-Marquardt fit of all sizes at once, in bounds: (thetas, rss, stds).
+
+    A k-parameter hypothesis (all parameters positive) is fitted in the logarithms of its parameters;
+    its size and std in the result are vectors."""
     comp = Compound(rec, data, hyps)
     meas = data.meas
     # a gain keeps the sign it starts with (a reversed polarity stays reversed)
-    neg = [_channel.is_log_sized(h) and t < 0 for h, t in zip(hyps, start)]
-    lo = np.array([-h.upper if n else h.lower for h, n in zip(hyps, neg)], float)
-    hi = np.array([-h.lower if n else h.upper for h, n in zip(hyps, neg)], float)
-    scale = np.array([1.0 if _channel.is_log_sized(h) else max(h.scale, 1e-300) for h in hyps])
+    neg = [_channel.is_log_sized(h) and not h.params and np.ndim(t) == 0 and t < 0 for h, t in zip(hyps, start)]
+    lo, hi, scale, logp, x0, cuts = [], [], [], [], [], [0]
+    for h, n, t in zip(hyps, neg, start):
+        if h.params:
+            lo += [math.log(p.lower) for p in h.params]
+            hi += [math.log(p.upper) for p in h.params]
+            scale += [1.0] * len(h.params)
+            logp += [True] * len(h.params)
+            x0 += list(np.log(np.maximum(np.asarray(t, float), 1e-300)))
+        else:
+            lo.append(-h.upper if n else h.lower)
+            hi.append(-h.lower if n else h.upper)
+            scale.append(1.0 if _channel.is_log_sized(h) else max(h.scale, 1e-300))
+            logp.append(False)
+            x0.append(float(t))
+        cuts.append(len(lo))
+    lo, hi, scale, logp = (np.array(lo, float), np.array(hi, float), np.array(scale, float),
+                           np.array(logp, bool))
+
+    def unpack(y):
+        v = np.where(logp, np.exp(np.clip(y, lo, hi)), np.clip(y, lo, hi))
+        return [v[a:b] if h.params else float(v[a]) for h, a, b in zip(hyps, cuts[:-1], cuts[1:])]
 
     def resid(x):
-        th = np.clip(x * scale, lo, hi)
+        th = unpack(x * scale)
         with np.errstate(all="ignore"):
-            r = np.concatenate([np.log(hh / m) for hh, m in zip(comp.responses(list(th)), meas)])
+            r = np.concatenate([np.log(hh / m) for hh, m in zip(comp.responses(th), meas)])
         r = np.concatenate([r.real, r.imag])
         return np.where(np.isfinite(r), r, 1e3)
 
-    x0 = np.clip(np.asarray(start, float), lo, hi) / scale
+    x0 = np.clip(np.asarray(x0, float), lo, hi) / scale
     try:
         sol = so.least_squares(resid, x0, bounds=(lo / scale, hi / scale), method="trf", x_scale="jac",
-                               max_nfev=iters * (len(hyps) + 1))
+                               max_nfev=iters * (len(x0) + 1))
         x = sol.x
         J = sol.jac
     except (ValueError, np.linalg.LinAlgError):
         x = x0
         J = None
-    th = np.clip(x * scale, lo, hi)
-    rss = _safe_rss(comp, list(th))
-    stds = [math.inf] * len(hyps)
+    th = unpack(x * scale)
+    rss = _safe_rss(comp, th)
+    sd = np.full(len(x0), math.inf)
     if J is not None:
         try:
             cov = np.linalg.inv(J.T @ J) * s2
-            stds = [float(math.sqrt(max(cov[i, i], 0.0)) * scale[i]) for i in range(len(hyps))]
+            sd = np.sqrt(np.maximum(np.diag(cov), 0.0)) * scale
         except np.linalg.LinAlgError:
             pass
-    return [float(t) for t in th], rss, stds
+    flat = np.concatenate([np.atleast_1d(t) for t in th])
+    sd = np.where(logp, flat * sd, sd)                       # first order: std(p) = p std(ln p)
+    stds = [sd[a:b] if h.params else float(sd[a]) for h, a, b in zip(hyps, cuts[:-1], cuts[1:])]
+    return [t if h.params else float(t) for h, t in zip(hyps, th)], rss, stds
 
 
 def at_bound(h, theta: float, rel: float = 1e-4) -> bool:
     """Whether a fitted size sits at a bound of its range (an added element at 0 is no effect, not a bound)."""
+    if h.params:                      # k parameters, all positive: any one at a bound (in log terms)
+        return any(abs(math.log(max(float(t), 1e-300) / b)) <= rel * math.log(p.upper / p.lower)
+                   for p, t in zip(h.params, theta) for b in (p.lower, p.upper))
     log_sized = _channel.is_log_sized(h)
     span = math.log(h.upper / h.lower) if log_sized else (h.upper - h.lower)
     for b in (h.lower, h.upper):

@@ -6,6 +6,16 @@ from dataclasses import dataclass, field
 import numpy as np
 
 
+@dataclass(frozen=True)
+class Param:
+    """One parameter of a k-parameter hypothesis: name, unit, bounds and typical size (SI)."""
+    name: str
+    unit: str
+    lower: float
+    upper: float
+    scale: float
+
+
 @dataclass
 class Hypothesis:
     """One candidate cause: a *kind* at a *location*, with a size to fit.
@@ -47,6 +57,17 @@ class Hypothesis:
     nominal : float
         Value of the existing parameter (changes) or 0 (added elements); the
         new value is ``nominal + size`` (gains: ``nominal * size``).
+    params : tuple of Param
+        A hypothesis with k > 1 parameters (e.g. a tuned-mass absorber's mass,
+        spring and damper): their names, units, bounds and scales.  Its size is
+        then a vector of k values in this order; ``lower``, ``upper``, ``scale``
+        and ``unit`` describe the first.  Empty for one-parameter hypotheses.
+    change : callable or None
+        ``change(theta, w)``: the change of dynamic stiffness on ``dofs`` at
+        the parameter vector ``theta``, ``(w.size, |U|, |U|)`` complex (k > 1).
+    starts : list of ndarray
+        Starting parameter vectors for the fit (k > 1): the best by the
+        residual starts a bounded least-squares fit.
     """
     kind: str
     station: int | None
@@ -65,6 +86,14 @@ class Hypothesis:
     nominal: float = 0.0
     crack: object = None          # callable depth -> dK on dofs (crack hypotheses)
     glob: str | None = None       # a change of the whole structure (:mod:`mutext.diagnose.faults.structure`)
+    params: tuple = ()            # k > 1 parameters (Param each); empty for a scalar size
+    change: object = None         # callable (theta vector, w) -> D(w) on dofs (k > 1)
+    starts: list = field(default_factory=list, repr=False)
+
+    @property
+    def n_params(self) -> int:
+        """Number of parameters fitted (k)."""
+        return max(1, len(self.params))
 
     @property
     def label(self) -> str:
@@ -75,6 +104,8 @@ def local_change(h: Hypothesis, theta: float, w) -> np.ndarray:
     """The change of dynamic stiffness of a local hypothesis on its DOFs at size ``theta``, per frequency:
     ``(w.size, |U|, |U|)`` (a crack's exact stiffness change, else ``theta (1, j w, -w^2)[order] S``)."""
     w = np.asarray(w, float)
+    if h.change is not None:
+        return np.asarray(h.change(np.asarray(theta, float), w), complex)
     if h.crack is not None:
         dK = np.asarray(h.crack(theta))
         return np.broadcast_to(dK, (w.size,) + dK.shape).astype(complex)

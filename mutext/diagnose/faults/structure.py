@@ -17,16 +17,15 @@ one solve per frequency.  Cheap for lumped chains; for a 120-DOF rotor about
 0.1 s per evaluation.
 
 A damping scale is written into the model file by scaling every damping value
-it holds (dampers, bearings' damping, the ``[damping]`` table); a frequency
-scale is a correction of the measurement and leaves the model unchanged.
+it holds (dampers, bearings' damping, the ``[damping]`` table;
+:class:`mutext.rotor.model_writer.ModelFile`); a frequency scale is a correction of the measurement and leaves the model unchanged.
 """
 from __future__ import annotations
-
-import re
 
 import numpy as np
 
 from ...errors import ModelError
+from ...rotor.model_writer import ModelFile
 from ._base import Hypothesis, local_change
 
 KINDS = ("damping_scale", "frequency_scale")
@@ -81,33 +80,13 @@ def responses(rec, data, hyps: list, thetas: list) -> list:
     return out
 
 
-def _scale_numbers(text: str, tables: dict, factor: float, note: str) -> tuple[str, int]:
-    """Multiply ``key = number`` in every table named in ``tables`` (name -> keys); returns (text, count)."""
-    lines = text.splitlines()
-    current, count = None, 0
-    for i, ln in enumerate(lines):
-        m = re.match(r"^\s*\[\[?\s*([A-Za-z_]+)\s*\]\]?", ln)
-        if m:
-            current = m.group(1)
-            continue
-        if current not in tables:
-            continue
-        m = re.match(r"^(\s*([A-Za-z_]+)\s*=\s*)([-+0-9.eE]+)(\s*(#.*)?)$", ln)
-        if m and m.group(2) in tables[current]:
-            v = float(m.group(3)) * factor
-            lines[i] = f"{m.group(1)}{v:.8g}   # {note} (was {m.group(3)})"
-            count += 1
-        elif re.match(rf"^\s*({'|'.join(tables[current])})\s*=", ln):
-            raise ModelError(f"cannot scale the damping of the model file: '{ln.strip()}' is not a plain number")
-    return "\n".join(lines) + "\n", count
-
-
 def model_text(text: str, finding, note: str) -> str:
     """The model file with the finding written in (damping scaled; a frequency scale only noted)."""
     if finding.kind == "frequency_scale":
         return "# (the analyser's frequency axis: the model itself is unchanged)\n" + text
-    out, count = _scale_numbers(text, {"damper": ("damping",), "bearing": ("damping", "damping_y"),
-                                       "damping": ("modal", "alpha", "beta")}, 1 + finding.value, note)
+    mf = ModelFile(text)
+    count = mf.scale({"damper": ("damping",), "bearing": ("damping", "damping_y"),
+                      "damping": ("modal", "alpha", "beta")}, 1 + finding.value, note)
     if count == 0:
         raise ModelError("the model file holds no damping value to scale")
-    return out
+    return mf.text()

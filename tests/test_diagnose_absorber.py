@@ -1,0 +1,69 @@
+"""A tuned-mass absorber (an added degree of freedom) hidden in data from the independent generator.
+
+The data come from ``benchmarks/_open_world.py`` (written apart from the package: the absorber is an
+extra row and column of its numpy M, C, K, ``with_absorber``).  The diagnosis must name the kind and
+the host mass, fit the absorber's mass, spring and damper within three of their reported standard
+uncertainties, call the result explained, and write a model file that, loaded by the model reader,
+reproduces the generator's noise-free data.
+"""
+import math
+import sys
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "benchmarks"))
+from _open_world import make_case, with_absorber  # noqa: E402
+
+from mutext.diagnose import diagnose  # noqa: E402
+from mutext.diagnose.faults.absorber import impedance  # noqa: E402
+from mutext.rotor.model import load_model  # noqa: E402
+from mutext.rotor.tuning import model_response  # noqa: E402
+
+NOISE = 0.01
+
+
+def _truth(case):
+    det = case.key["details"]
+    ma = det["value"] if "value" in det else det["size"]
+    ka = ma * (2 * np.pi * det["tuned_hz"]) ** 2
+    return det["station"], np.array([ma, ka, 2 * det["zeta"] * math.sqrt(ka * ma)])
+
+
+def test_absorber_impedance_is_the_added_degree_of_freedom_condensed():
+    # independent: the 2x2 dynamic stiffness of host + absorber, the absorber's row eliminated
+    rng = np.random.default_rng(4)
+    ma, ka, ca = 0.3, 2.0e3, 1.5
+    w = 2 * np.pi * rng.uniform(0.5, 30, 50)
+    M, C, K = with_absorber(np.eye(1), np.zeros((1, 1)), np.zeros((1, 1)), 0, ma, ka, ca)
+    Z = K[None] - (w * w)[:, None, None] * M[None] + 1j * w[:, None, None] * C[None]
+    schur = Z[:, 0, 0] - Z[:, 0, 1] * Z[:, 1, 0] / Z[:, 1, 1]
+    host = 1.0 * -(w * w)                                    # the host's own unit mass
+    assert np.allclose(impedance((ma, ka, ca), w), schur - host, rtol=1e-12, atol=0)
+
+
+@pytest.mark.parametrize("example,seed", [("three_mass", 0),
+                                          pytest.param("four_story", 1, marks=pytest.mark.slow)])
+def test_a_hidden_absorber_is_found_sized_and_written(example, seed, tmp_path):
+    case = make_case(example, "out_of_library", "tuned_absorber", seed, NOISE)
+    station, truth = _truth(case)
+    d = diagnose(case.model_path, case.measured, validate=case.validate, out_dir=tmp_path)
+    assert d.status == "explained" and d.confirmed, d.report()
+    assert [(f.kind, f.station) for f in d.effects] == [("absorber", station)], d.report()
+    f = d.effects[0]
+    for name, v, sd, t in zip(("m_a", "k_a", "c_a"), f.values, f.stds, truth):
+        assert abs(v - t) <= 3 * sd, (name, v, sd, t)
+        assert sd < 0.2 * t, (name, sd, t)            # a real measurement, not an unbounded one
+    report = d.report()
+    assert "m_a" in report and "k_a" in report and "c_a" in report
+    assert f.as_dict()["parameters"]["k_a"]["unit"] == "N/m"
+    # the model file written: the extra mass, its spring and damper; it reproduces the clean data
+    ext = load_model(d.extended_model)
+    assert ext.layout.n_nodes == load_model(case.model_path).layout.n_nodes + 1
+    errs = []
+    for frf, clean in zip(case.measured, case.clean):
+        H = model_response(ext, frf)
+        errs.append(np.abs(np.log(H / clean)))
+    rms = float(np.sqrt(np.mean(np.concatenate(errs) ** 2)))
+    assert rms < 0.3 * NOISE, rms
