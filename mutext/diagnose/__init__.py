@@ -9,7 +9,10 @@ r"""Diagnosis: what a model gets wrong against measured FRFs, its cause, the fix
    has no partner for);
 2. tests hypotheses of the form *kind at location* -- a change of a spring,
    mass or damper, a grounded spring, mass or damper added at a mass or a
-   station, a bearing's stiffness or damping, a crack in a shaft element; on
+   station, a bearing's stiffness or damping, a crack in a shaft element
+   (:mod:`~mutext.diagnose.faults.lumped`, :mod:`~mutext.diagnose.faults.rotor`,
+   :mod:`~mutext.diagnose.faults.crack`), a tuned-mass absorber at a mass of
+   a chain (three parameters, :mod:`~mutext.diagnose.faults.absorber`); on
    the measurement chain a sensor's or exciter's gain (either sign), one
    file's scale (unit slips, named as such), a sensor's delay, a mass that
    moves with the sensor (:mod:`~mutext.diagnose.faults.channel`); for the whole
@@ -77,7 +80,11 @@ hypotheses) the response of the changed model is exact for any size
 with :math:`o` the output DOF and :math:`b_c` the input vector of the
 channel.  A crack is the same with :math:`\theta D` replaced by the exact
 cracked-minus-intact stiffness of its shaft element
-(:class:`mutext.rotor.crack.Crack`), a function of the depth ratio.  A sensor
+(:class:`mutext.rotor.crack.Crack`), a function of the depth ratio; an
+absorber the same with the impedance :math:`Z(\omega; m_a, k_a, c_a)` of its
+condensed degree of freedom, its three parameters fitted together (bounded
+least squares in their logarithms, the threshold that of
+:math:`\chi^2_3` at the same false-alarm rate, :math:`3\ln N` in the score).  A sensor
 or exciter gain :math:`g` multiplies the channels of that sensor or
 exciter: :math:`\ln g` enters the residual linearly.  The damping matrix of
 the engineering model (modal damping included) is held fixed in this screen.
