@@ -22,6 +22,15 @@ model
     TOML model files for rotors and lumped chains.
 analysis
     Natural frequencies, mode shapes, whirl, Campbell data, FRFs, state space.
+campbell_diagram
+    :func:`campbell`: whirl frequencies, forward/backward, log decrement and the
+    critical speeds where the 1x, 2x, 3x lines cross the modes.
+modal
+    :func:`mode_shapes`: the modes at a speed along the shaft, with log decrement and whirl.
+unbalance
+    :func:`unbalance_response`: steady 1x response to unbalance at probes (Bode, polar), run-up.
+orbits
+    :func:`orbit`: the x-y path of a station from harmonic components; forward/backward ellipses.
 analytic
     Closed-form beam frequencies (references for the finite elements).
 reduction
@@ -56,6 +65,11 @@ from .assembly import (Matrices, ModalDamping, ProportionalDamping, Rotor, Shaft
 from .elements import (BearingElement, Damper, DiskElement, Element, ExciterElement, InputPort, Layout,
                        OutputPort, Param, PointMass, ShaftElement, Spring)
 from .model import load_model, loads_model, rotor_from_table
+from .campbell_diagram import CampbellDiagram, Crossing, campbell
+from .modal import ModeShapes, mode_shapes
+from .orbits import Ellipse, Orbit, ellipse, orbit
+from .unbalance import UnbalanceResponse, run_up, unbalance_response
+from .units import rad_s_to_rpm, rpm_to_rad_s
 from .reduction import Reduction, balanced_truncation, hankel_singular_values, modal_truncation, reduction_error
 from .tuning import FRFSensitivity, TuneResult, frf_sensitivity, model_response, tune
 from .table import Station, StationTable, parse_station_table, read_station_table
@@ -68,6 +82,8 @@ __all__ = [
     "read_station_table", "data_path",
     "Reduction", "balanced_truncation", "hankel_singular_values", "modal_truncation", "reduction_error",
     "FRFSensitivity", "TuneResult", "frf_sensitivity", "model_response", "tune",
+    "CampbellDiagram", "Crossing", "campbell", "ModeShapes", "mode_shapes", "Ellipse", "Orbit", "ellipse", "orbit",
+    "UnbalanceResponse", "run_up", "unbalance_response", "rpm_to_rad_s", "rad_s_to_rpm",
 ]
 
 
