@@ -67,3 +67,18 @@ def test_a_hidden_absorber_is_found_sized_and_written(example, seed, tmp_path):
         errs.append(np.abs(np.log(H / clean)))
     rms = float(np.sqrt(np.mean(np.concatenate(errs) ** 2)))
     assert rms < 0.3 * NOISE, rms
+
+
+def test_a_loss_shared_by_every_spring_is_found_as_a_distributed_change(tmp_path):
+    """The generator's ``stiffness_loss`` (its K times 1 - d, every spring alike) is the run of all springs
+    changed by -d: kind, run and size within three reported standard uncertainties, explained, and the
+    written file reproduces the clean data."""
+    case = make_case("three_mass", "out_of_library", "stiffness_loss", 0, NOISE)
+    d = diagnose(case.model_path, case.measured, validate=case.validate, out_dir=tmp_path)
+    assert d.status == "explained" and d.confirmed, d.report()
+    assert [(f.kind, f.element) for f in d.effects] == [("distributed_stiffness", "k1..k3")], d.report()
+    f = d.effects[0]
+    assert abs(f.value - (-case.key["details"]["value"])) <= 3 * f.std, (f.value, f.std)
+    ext = load_model(d.extended_model)
+    errs = [np.abs(np.log(model_response(ext, frf) / clean)) for frf, clean in zip(case.measured, case.clean)]
+    assert float(np.sqrt(np.mean(np.concatenate(errs) ** 2))) < 0.3 * NOISE

@@ -155,7 +155,7 @@ def test_every_lumped_kind_is_written_and_read_back():
     text = open(THREE_MASS, encoding="utf-8").read()
     model = loads_model(text, source=THREE_MASS)
     original = tomllib.loads(text)
-    hyps = [h for h in hypotheses(model) if h.gain is None and h.glob is None and not h.params]
+    hyps = [h for h in hypotheses(model) if h.gain is None and h.glob is None and not h.params and not h.run]
     assert {h.kind for h in hyps} == {"stiffness", "damping", "mass"} and any(h.added for h in hyps)
     for h in hyps:
         value = 0.37 * h.scale
@@ -235,3 +235,21 @@ def test_an_absorber_is_written_as_a_mass_with_its_spring_and_damper():
         assert np.allclose(X1, want, rtol=1e-14, atol=0)
     assert M1[n, n] == 0.2 and np.allclose(M1[:n, :n], M0)
     assert all(c in out for c in _comments(text))
+
+
+def test_a_distributed_change_is_written_into_every_spring_of_its_run():
+    text = open(THREE_MASS, encoding="utf-8").read()
+    model = loads_model(text, source=THREE_MASS)
+    original = {t["name"]: t["stiffness"] for t in tomllib.loads(text)["spring"]}
+    runs = [h for h in hypotheses(model) if h.kind == "distributed_stiffness"]
+    assert sorted(h.run for h in runs) == [("k1", "k2"), ("k1", "k2", "k3"), ("k2", "k3")]
+    for h in runs:
+        out = extended_model_text(text, _finding(h, -0.08), model)
+        got = {t["name"]: t["stiffness"] for t in tomllib.loads(out)["spring"]}
+        assert got == pytest.approx({k: v * (0.92 if k in h.run else 1.0) for k, v in original.items()},
+                                    rel=1e-14)
+        ext = loads_model(out, source="extended")
+        # the screen's pattern is the stiffness change of the file read back
+        dK = ext.matrices()[2] - model.matrices()[2]
+        assert np.allclose(dK[np.ix_(h.dofs, h.dofs)], -0.08 * h.pattern, rtol=1e-12, atol=1e-12)
+        assert all(c in out for c in _comments(text))

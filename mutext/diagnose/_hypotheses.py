@@ -10,6 +10,7 @@ from ._channels import _resolve
 from .faults import absorber as _absorber
 from .faults import channel as _channel
 from .faults import crack as _crack
+from .faults import distributed as _distributed
 from .faults import lumped as _lumped
 from .faults import rotor as _rotor
 from .faults import structure as _structure
@@ -18,7 +19,7 @@ from .faults._base import Hypothesis
 __all__ = ["KINDS", "Hypothesis", "hypotheses", "write_finding"]
 
 #: Kinds of finding (the ``kind`` field of :class:`~mutext.diagnose.Finding`).
-KINDS = (("stiffness", "mass", "damping", "crack", "bearing") + _absorber.KINDS + _channel.KINDS
+KINDS = (("stiffness", "mass", "damping", "crack", "bearing") + _absorber.KINDS + _distributed.KINDS + _channel.KINDS
          + _structure.KINDS + ("none",))
 
 
@@ -27,7 +28,7 @@ def hypotheses(model, frfs=None, *, stations=None) -> list[Hypothesis]:
     if isinstance(model, (str, os.PathLike)):
         model = load_model(model)
     if model.layout.kind == "lumped":
-        hyps = _lumped.candidates(model) + _absorber.candidates(model)
+        hyps = _lumped.candidates(model) + _distributed.candidates(model) + _absorber.candidates(model)
     else:
         hyps = _rotor.candidates(model, stations) + _crack.candidates(model, stations)
     if frfs is not None:
@@ -41,6 +42,8 @@ def write_finding(mf, finding, model, note: str) -> None:
     h = finding.hypothesis
     if h.kind == "absorber":
         home = _absorber
+    elif h.kind == "distributed_stiffness":
+        home = _distributed
     elif model.layout.kind == "lumped":
         home = _lumped
     else:

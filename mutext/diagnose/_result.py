@@ -68,7 +68,7 @@ class Finding:
             return f"x{self.value:.4g}" + (f" +/- {self.std:.2g}" if std else "")
         if self.kind == "crack":
             return f"a/D {self.value:.4g}" + (f" +/- {self.std:.2g}" if std else "")
-        if self.kind in ("damping_scale", "frequency_scale"):
+        if self.kind in ("damping_scale", "frequency_scale", "distributed_stiffness"):
             return f"{100 * self.value:+.4g}" + (f" +/- {100 * self.std:.2g}" if std else "") + " %"
         if self.kind == "sensor_delay":
             return f"{1e3 * self.value:+.4g}" + (f" +/- {1e3 * self.std:.2g}" if std else "") + " ms"

@@ -89,6 +89,7 @@ class Hypothesis:
     params: tuple = ()            # k > 1 parameters (Param each); empty for a scalar size
     change: object = None         # callable (theta vector, w) -> D(w) on dofs (k > 1)
     starts: list = field(default_factory=list, repr=False)
+    run: tuple = ()               # the elements of a run (distributed kinds), in order
 
     @property
     def n_params(self) -> int:
