@@ -281,3 +281,70 @@ def test_orbit_with_2x_has_an_inner_loop():
         orbit(one, 0.0)
     with pytest.raises(ModelError, match="orders"):
         orbit({-1: (1.0, 1.0)}, 1.0)
+
+
+# ----------------------------------------------------------------------------- breathing crack: all orders
+
+def test_periodic_response_without_crack_is_sag_plus_unbalance_of_plain_rotor():
+    from mutext.rotor.periodic_orbit import GRAVITY, periodic_unbalance_response
+    model, rot = healthy_rotor(), plain_rotor()
+    W, U = rpm_to_rad_s(1000.0), 2e-6
+    r = periodic_unbalance_response(model, W, [15], unbalance=(16, U), harmonics=3)
+    ev = np.zeros(rot.ndof)
+    ev[[rot.dof(s, "v") for s in rot.node_of]] = 1.0
+    sag = np.linalg.solve(rot.K, -GRAVITY * rot.M @ ev)
+    F = np.zeros(rot.ndof, complex)
+    F[rot.dof(16, "u")], F[rot.dof(16, "v")] = U * W ** 2, -1j * U * W ** 2
+    Q = np.linalg.solve(rot.K - W ** 2 * rot.M + 1j * W * (rot.C + W * rot.G), F)
+    assert r.Y[0, 0].real == pytest.approx(sag[rot.dof(15, "v")], rel=1e-8)
+    assert abs(r.X[0, 0]) < 1e-9 * abs(r.Y[0, 0])
+    assert r.X[1, 0] == pytest.approx(Q[rot.dof(15, "u")], rel=1e-7)
+    assert r.Y[1, 0] == pytest.approx(Q[rot.dof(15, "v")], rel=1e-7)
+    assert np.all(np.abs(r.X[2:]) < 1e-12 * abs(r.X[1, 0]))        # time-invariant: no higher orders
+
+
+@pytest.mark.slow
+def test_breathing_crack_harmonic_balance_against_time_integration():
+    """The harmonic balance on a Ritz basis against a time integration of the same reduced model with the
+    breathing law evaluated directly (not through its Fourier series), started on the periodic solution."""
+    from scipy.integrate import solve_ivp
+
+    from mutext.examples.cracked_rotor import cracked_rotor
+    from mutext.rotor.periodic import periodic_rotor
+    from mutext.rotor.periodic_orbit import periodic_steady_state, weight_force
+    from mutext.rotor.unbalance import unbalance_force
+    model = cracked_rotor()
+    W = rpm_to_rad_s(1000.0)
+    pr = periodic_rotor(model, speed=W)
+    P = pr.ritz_basis(400.0)
+    red = pr.project(P)
+    f0 = P.T @ weight_force(model, pr.M)
+    F1 = P.T @ unbalance_force(model, [(16, 1e-5, 0.0)], W)
+    N = 8
+    Q = periodic_steady_state(red, {0: f0, 1: F1}, N)
+    ks = np.arange(-N, N + 1)
+    t = np.linspace(0.0, 2 * np.pi / W, 41)
+    hb = (np.exp(1j * W * np.outer(t, ks)) @ Q).real                        # (t, r)
+    z0 = (Q.sum(axis=0)).real
+    dz0 = (1j * W * ks @ Q).real
+    Minv = np.linalg.inv(red.M)
+
+    def rhs(tt, s):
+        r = red.n
+        z, dz = s[:r], s[r:]
+        K = red.stiffness_at(W * tt)[0]
+        f = f0 + (F1 * np.exp(1j * W * tt)).real
+        return np.concatenate([dz, Minv @ (f - red.D @ dz - K @ z)])
+
+    sol = solve_ivp(rhs, (0.0, t[-1]), np.concatenate([z0, dz0]), t_eval=t, method="DOP853", rtol=1e-10,
+                    atol=1e-14)
+    z = sol.y[:red.n].T
+    x_hb = hb @ P.T
+    x_ti = z @ P.T
+    dof = [model.layout.dof(15, "u"), model.layout.dof(15, "v")]
+    dyn = x_hb[:, dof] - x_hb[:, dof].mean(axis=0)
+    err = np.max(np.abs(x_hb[:, dof] - x_ti[:, dof])) / np.max(np.abs(dyn))
+    print(f"harmonic balance vs time integration: {err:.2e}")
+    assert err < 1e-3, err
+    # and the 2x order is what dominates near half the critical speed
+    assert np.abs(2 * Q[N + 2] @ P.T[:, dof[0]]) > np.abs(2 * Q[N + 1] @ P.T[:, dof[0]])

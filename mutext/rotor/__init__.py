@@ -29,6 +29,9 @@ modal
     :func:`mode_shapes`: the modes at a speed along the shaft, with log decrement and whirl.
 unbalance
     :func:`unbalance_response`: steady 1x response to unbalance at probes (Bode, polar), run-up.
+periodic_orbit
+    :func:`periodic_unbalance_response`: weight and unbalance on a rotor with a breathing
+    crack, every order of the steady response (the 2x inner loop of the orbit).
 orbits
     :func:`orbit`: the x-y path of a station from harmonic components; forward/backward ellipses.
 analytic
@@ -69,6 +72,7 @@ from .campbell_diagram import CampbellDiagram, Crossing, campbell
 from .modal import ModeShapes, mode_shapes
 from .orbits import Ellipse, Orbit, ellipse, orbit
 from .unbalance import UnbalanceResponse, run_up, unbalance_response
+from .periodic_orbit import PeriodicResponse, periodic_unbalance_response
 from .units import rad_s_to_rpm, rpm_to_rad_s
 from .reduction import Reduction, balanced_truncation, hankel_singular_values, modal_truncation, reduction_error
 from .tuning import FRFSensitivity, TuneResult, frf_sensitivity, model_response, tune
@@ -84,6 +88,7 @@ __all__ = [
     "FRFSensitivity", "TuneResult", "frf_sensitivity", "model_response", "tune",
     "CampbellDiagram", "Crossing", "campbell", "ModeShapes", "mode_shapes", "Ellipse", "Orbit", "ellipse", "orbit",
     "UnbalanceResponse", "run_up", "unbalance_response", "rpm_to_rad_s", "rad_s_to_rpm",
+    "PeriodicResponse", "periodic_unbalance_response",
 ]
 
 
