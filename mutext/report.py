@@ -64,7 +64,10 @@ def diagnosis_figures(result, outdir) -> list[str]:
     n = len(chans)
     ncol = min(n, 3)
     nrow = -(-n // ncol)
-    fig, axes = plt.subplots(2 * nrow, ncol, figsize=(4.4 * ncol, 4.6 * nrow), squeeze=False, sharex="col")
+    # at most 7.2 in wide (790 px at the 110 dpi of _save): the width of a book or report column,
+    # so the figure is shown at its own size and its text is not scaled down
+    fig, axes = plt.subplots(2 * nrow, ncol, figsize=(min(4.4 * ncol, 7.2), 3.8 * nrow), squeeze=False,
+                             sharex="col")
     for k in range(n, nrow * ncol):
         axes[2 * (k // ncol), k % ncol].set_visible(False)
         axes[2 * (k // ncol) + 1, k % ncol].set_visible(False)
@@ -79,10 +82,12 @@ def diagnosis_figures(result, outdir) -> list[str]:
             axp.plot(c.freq_hz, np.degrees(np.angle(c.after)), "--", color="C0", lw=1.2)
         ax.set_title(f"{c.label} ({c.role})", fontsize=9)
         axp.set_xlabel("frequency [Hz]")
-        if k == 0:
-            ax.set_ylabel("|H| [SI]")
+        if k % ncol == 0:
+            # receptance: displacement per force, or per current for an exciter driven by current
+            ax.set_ylabel("|H| [m/N or m/A]")
             axp.set_ylabel("phase [deg]")
-            ax.legend(fontsize=7)
+        if k == 0:
+            ax.legend(fontsize=8)
     paths.append(_save(fig, outdir, "overlay.png"))
 
     fig, ax = plt.subplots(figsize=(7, 3.6))
