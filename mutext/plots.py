@@ -17,7 +17,9 @@ from .report import diagnosis_figures
 
 __all__ = ["frequency_grid", "bode_mag", "bode_phase", "sigma_plot", "closed_loop_figure",
            "controller_figure", "sigma_figure", "two_mass_hinf_figures", "mbi_figure", "diagnosis_figures",
-           "sideband_figure", "crack_identification_figure", "crack_figures"]
+           "sideband_figure", "crack_identification_figure", "crack_figures",
+           "campbell_figure", "mode_shapes_figure", "unbalance_bode_figure", "unbalance_polar_figure",
+           "orbit_figure"]
 
 
 def frequency_grid(*systems, decades: float = 1.5, n: int = 800) -> np.ndarray:
@@ -409,3 +411,162 @@ def crack_figures(out, outdir) -> list[str]:
         files.append(_save(sideband_figure(meas, out["sidebands_evidence"], out["engineering"]), outdir,
                            "crack_sidebands.png"))
     return files
+
+
+# ----------------------------------------------------------------------------- rotordynamics
+# Each draws a result of mutext.rotor (campbell, mode_shapes, unbalance_response, orbit): data only.
+
+_WHIRL_STYLE = {"forward": ("^", "C0"), "backward": ("v", "C3"), "mixed": ("o", "0.5"),
+                "degenerate": ("o", "0.5"), "": ("o", "0.5")}
+
+
+def campbell_figure(cd, *, log_dec: bool = True, title=None, label_orders=(1, 2, 3)):
+    """Campbell diagram of a :class:`mutext.rotor.CampbellDiagram`: whirl frequencies against speed
+    (forward up-triangles, backward down-triangles), the excitation lines of its orders, the critical
+    speeds found on them (circles; forward ones of ``label_orders`` labelled in rpm), and, with ``log_dec``,
+    the logarithmic decrement of every mode below."""
+    plt = _plt()
+    rpm = cd.speeds_rpm
+    if log_dec:
+        fig, (ax, bx) = plt.subplots(2, 1, figsize=(7.0, 6.0), sharex=True, gridspec_kw={"height_ratios": [3, 1.3]})
+    else:
+        fig, ax = plt.subplots(figsize=(7.0, 4.5))
+        bx = None
+    n = cd.frequencies_hz.shape[1]
+    for r in range(n):
+        ax.plot(rpm, cd.frequencies_hz[:, r], "-", color="0.75", lw=0.8, zorder=1)
+        for name, (m, c) in _WHIRL_STYLE.items():
+            k = np.array([cd.direction[i][r] == name for i in range(rpm.size)])
+            if k.any():
+                ax.plot(rpm[k], cd.frequencies_hz[k, r], m, color=c, ms=4, zorder=2)
+                if bx is not None:
+                    bx.plot(rpm[k], cd.log_dec[k, r], m, color=c, ms=3)
+        if bx is not None:
+            bx.plot(rpm, cd.log_dec[:, r], "-", color="0.75", lw=0.8, zorder=1)
+    top = np.nanmax(cd.frequencies_hz) * 1.08
+    for j, k in enumerate(cd.orders):
+        ax.plot(rpm, k * rpm / 60.0, "k", ls=["-", "--", ":", "-."][j % 4], lw=0.9, label=f"{k}x")
+    for c in cd.crossings:
+        ax.plot(c.speed_rpm, c.frequency_hz, "o", mfc="none", mec="k", ms=7, zorder=3)
+        if c.whirl == "forward" and c.order in label_orders:
+            ax.annotate(f"{c.order}x: {c.speed_rpm:.0f} rpm", (c.speed_rpm, c.frequency_hz),
+                        textcoords="offset points", xytext=(4, -12 - 9 * (c.order % 2)), fontsize=8)
+    ax.plot([], [], "^", color="C0", label="forward whirl")
+    ax.plot([], [], "v", color="C3", label="backward whirl")
+    ax.plot([], [], "o", mfc="none", mec="k", label="critical speed (crossing)")
+    ax.set_ylim(0, top)
+    ax.set_xlim(rpm[0], rpm[-1])
+    ax.set_ylabel("frequency [Hz]")
+    ax.grid(True, alpha=0.3)
+    ax.legend(fontsize=8, loc="upper left")
+    ax.set_title(title or f"Campbell diagram: {cd.name}", fontsize=10)
+    if bx is not None:
+        bx.set_ylabel("log decrement")
+        bx.grid(True, alpha=0.3)
+        bx.set_xlabel("speed [rpm]")
+    else:
+        ax.set_xlabel("speed [rpm]")
+    fig.tight_layout()
+    return fig
+
+
+def mode_shapes_figure(ms, *, marks=None, title=None):
+    """Mode shapes of a :class:`mutext.rotor.ModeShapes` along the shaft: per mode the whirl envelope
+    (the semi-major axis at each station, shaded) and the planar snapshot along the major axis
+    (``ms.shape``, signs show the nodes); the title of each panel gives frequency, damping ratio, log decrement and whirl.
+    ``marks`` maps a station to a label (bearings, disks) drawn as vertical lines."""
+    plt = _plt()
+    n = ms.frequencies_hz.size
+    fig, axes = plt.subplots(n, 1, figsize=(7.0, 1.7 * n + 0.6), sharex=True, squeeze=False)
+    z = 1e3 * ms.positions
+    for r, ax in enumerate(axes[:, 0]):
+        ax.fill_between(z, -ms.semi_major[:, r], ms.semi_major[:, r], color="C0", alpha=0.15, lw=0)
+        ax.plot(z, ms.shape[:, r], "C0o-", lw=1.2, ms=2.5, label="shape (along the major axis)")
+        for st, lab in (marks or {}).items():
+            ax.axvline(z[st - 1], color="0.5", lw=0.7, ls=":")
+            if r == 0:
+                ax.text(z[st - 1], 1.12, lab, fontsize=7, ha="center", color="0.3")
+        ax.set_ylim(-1.25, 1.25)
+        ax.set_title(f"mode {r + 1}: {ms.frequencies_hz[r]:.2f} Hz, zeta = {ms.damping_ratio[r]:.4f}, "
+                     f"log dec = {ms.log_dec[r]:.4f}, {ms.direction[r]}", fontsize=8, loc="left")
+        ax.grid(True, alpha=0.3)
+    axes[0, 0].fill_between([], [], [], color="C0", alpha=0.15, lw=0, label="whirl envelope (semi-major axis)")
+    axes[0, 0].legend(fontsize=7, loc="lower right")
+    axes[-1, 0].set_xlabel("axial position [mm]")
+    fig.suptitle(title or f"mode shapes at {ms.speed * 30 / np.pi:.0f} rpm (whirl envelope shaded)", fontsize=10)
+    fig.tight_layout()
+    return fig
+
+
+def _probe_label(p):
+    st, a = p
+    return f"station {st}" + (f", {np.degrees(a):.0f} deg" if a else " (x)")
+
+
+def unbalance_bode_figure(resp, *, critical=None, title=None):
+    """Bode plot of a :class:`mutext.rotor.UnbalanceResponse`: amplitude [µm] and phase [deg] at every probe
+    against speed [rpm]; ``critical`` (a list of :class:`mutext.rotor.Crossing`) drawn as vertical lines."""
+    plt = _plt()
+    fig, (a1, a2) = plt.subplots(2, 1, figsize=(7.0, 5.0), sharex=True)
+    for j, p in enumerate(resp.probes):
+        a1.semilogy(resp.speeds_rpm, 1e6 * resp.amplitude[:, j], label=_probe_label(p))
+        a2.plot(resp.speeds_rpm, np.degrees(resp.phase[:, j]))
+    for c in critical or ():
+        for a in (a1, a2):
+            a.axvline(c.speed_rpm, color="0.4", lw=0.8, ls=":")
+        a1.annotate(f"{c.order}x crit. {c.speed_rpm:.0f} rpm", (c.speed_rpm, a1.get_ylim()[1]),
+                    textcoords="offset points", xytext=(3, -10), fontsize=7, color="0.3")
+    a1.set_ylabel("amplitude [µm, 0-peak]")
+    a2.set_ylabel("phase [deg]")
+    a2.set_xlabel("speed [rpm]")
+    a1.legend(fontsize=8)
+    for a in (a1, a2):
+        a.grid(True, which="both", alpha=0.3)
+    u = ", ".join(f"{1e6 * m:g} g mm at station {s}" for s, m, _ in resp.unbalances)
+    a1.set_title(title or f"unbalance response ({u})", fontsize=10)
+    fig.tight_layout()
+    return fig
+
+
+def unbalance_polar_figure(resp, *, probe: int = 0, every=None, title=None):
+    """Polar (Nyquist) plot of one probe of a :class:`mutext.rotor.UnbalanceResponse`: the complex 1x
+    amplitude [µm] as the speed rises, with a few speeds labelled in rpm."""
+    plt = _plt()
+    P = 1e6 * resp.response[:, probe]
+    fig, ax = plt.subplots(figsize=(5.2, 5.0))
+    ax.plot(P.real, P.imag, "C0.-", ms=2.5, lw=0.8)
+    every = every or max(1, resp.speeds.size // 8)
+    for i in range(0, resp.speeds.size, every):
+        ax.annotate(f"{resp.speeds_rpm[i]:.0f}", (P[i].real, P[i].imag), fontsize=7, textcoords="offset points",
+                    xytext=(3, 3))
+    ax.plot([0], [0], "k+")
+    ax.set_aspect("equal", adjustable="datalim")
+    ax.set_xlabel("real [µm]")
+    ax.set_ylabel("imaginary [µm]")
+    ax.grid(True, alpha=0.3)
+    ax.set_title(title or f"polar plot, {_probe_label(resp.probes[probe])} (speeds in rpm)", fontsize=10)
+    fig.tight_layout()
+    return fig
+
+
+def orbit_figure(orbits, *, titles=None, title=None):
+    """Orbits (:class:`mutext.rotor.Orbit`) side by side in µm: the path, the keyphasor mark at t = 0 (dot)
+    and the sense of travel (arrow)."""
+    plt = _plt()
+    orbits = list(orbits)
+    fig, axes = plt.subplots(1, len(orbits), figsize=(min(7.0, 3.3 * len(orbits)), 3.4), squeeze=False)
+    for j, (o, ax) in enumerate(zip(orbits, axes[0])):
+        x, y = 1e6 * o.x, 1e6 * o.y
+        ax.plot(x, y, "C0-", lw=1.1)
+        ax.plot(x[0], y[0], "ko", ms=4)
+        k = max(1, len(x) // 40)
+        ax.annotate("", xy=(x[k], y[k]), xytext=(x[0], y[0]), arrowprops=dict(arrowstyle="->", color="C3"))
+        ax.set_aspect("equal", adjustable="datalim")
+        ax.set_xlabel("x [µm]")
+        ax.set_ylabel("y [µm]")
+        ax.grid(True, alpha=0.3)
+        ax.set_title((titles[j] if titles else o.label), fontsize=8)
+    if title:
+        fig.suptitle(title, fontsize=10)
+    fig.tight_layout()
+    return fig

@@ -180,6 +180,11 @@ def test_mode_shapes_against_plain_rotor():
     # the first pair bends the shaft between the bearings, largest near the disk (station 16)
     assert abs(int(np.argmax(ms.semi_major[:, 0])) + 1 - 16) <= 2
     assert np.all(ms.log_dec > 0)
+    # the planar snapshot: first pair without a node between the bearings, second pair with one
+    inside = slice(2, 28)
+    assert np.all(np.abs(ms.shape[inside, :2]) > 0) and np.all(np.sign(ms.shape[inside, 0]) == 1)
+    assert np.sum(np.diff(np.sign(ms.shape[inside, 2])) != 0) == 1
+    assert np.max(np.abs(ms.shape), axis=0) == pytest.approx(1.0)
 
 
 # ----------------------------------------------------------------------------- unbalance response
@@ -348,3 +353,28 @@ def test_breathing_crack_harmonic_balance_against_time_integration():
     assert err < 1e-3, err
     # and the 2x order is what dominates near half the critical speed
     assert np.abs(2 * Q[N + 2] @ P.T[:, dof[0]]) > np.abs(2 * Q[N + 1] @ P.T[:, dof[0]])
+
+
+# ----------------------------------------------------------------------------- figures draw the results
+
+def test_rotor_figures_draw_the_results():
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    from mutext import plots
+    cd = campbell(overhung(), np.linspace(0.0, 400.0, 9), 4)
+    fig = plots.campbell_figure(cd)
+    lines = [ln for ln in fig.axes[0].lines if ln.get_label() == "1x"]
+    np.testing.assert_allclose(lines[0].get_ydata(), cd.speeds_rpm / 60.0)
+    ms = mode_shapes(healthy_rotor(), 100.0, 2)
+    fig2 = plots.mode_shapes_figure(ms, marks={2: "bearing", 29: "bearing"})
+    np.testing.assert_allclose(fig2.axes[0].lines[0].get_ydata(), ms.shape[:, 0])
+    r = unbalance_response(jeffcott(c=20.0), 1, 1e-4, np.linspace(50.0, 400.0, 30), [1, (1, 0.5)])
+    fig3 = plots.unbalance_bode_figure(r, critical=campbell(jeffcott(c=20.0), [0.0, 400.0], 1).crossings[:1])
+    np.testing.assert_allclose(fig3.axes[0].lines[0].get_ydata(), 1e6 * r.amplitude[:, 0])
+    fig4 = plots.unbalance_polar_figure(r, probe=1)
+    np.testing.assert_allclose(fig4.axes[0].lines[0].get_xdata(), 1e6 * r.response[:, 1].real)
+    fig5 = plots.orbit_figure([r.orbit(5), r.orbit(20, 1)])
+    np.testing.assert_allclose(fig5.axes[1].lines[0].get_ydata(), 1e6 * r.orbit(20, 1).y)
+    plt.close("all")

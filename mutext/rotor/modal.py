@@ -7,7 +7,12 @@ station they describe an ellipse (the free whirl orbit,
 :func:`mutext.rotor.orbits.ellipse`), whose semi-major axis is the
 amplitude drawn along the shaft.  The shape is scaled so that the largest
 semi-major axis is 1 and the largest translation is real and positive.
-The logarithmic decrement is
+The planar shape drawn along the shaft, :attr:`ModeShapes.shape`, is the
+snapshot of the displacement along the major axis of the station that moves
+most, at the instant that station is furthest out:
+:math:`\mathrm{Re}\big((\hat u_s\cos\alpha + \hat v_s\sin\alpha)e^{-j\varphi}\big)`
+with :math:`\alpha` that major axis' angle and :math:`\varphi` the phase of
+its projection there (signs show the nodes).  The logarithmic decrement is
 :math:`\delta = -2\pi\,\mathrm{Re}\,\lambda/\mathrm{Im}\,\lambda`; a
 negative :math:`\delta` is an unstable mode.
 """
@@ -43,6 +48,8 @@ class ModeShapes:
         Translations in x and y at each station (scaled, see above).
     semi_major, semi_minor : ndarray (s, n)
         The whirl ellipse at each station.
+    shape : ndarray (s, n)
+        The planar snapshot along the major axis (module docstring), largest entry 1.
     """
     speed: float
     eigenvalues: np.ndarray
@@ -56,12 +63,14 @@ class ModeShapes:
     v: np.ndarray
     semi_major: np.ndarray
     semi_minor: np.ndarray
+    shape: np.ndarray
 
     def to_dict(self) -> dict:
         return {"speed_rad_s": self.speed, "frequencies_hz": self.frequencies_hz.tolist(),
                 "damping_ratio": self.damping_ratio.tolist(), "log_dec": self.log_dec.tolist(),
                 "whirl_index": self.whirl.tolist(), "direction": self.direction,
-                "positions_m": self.positions.tolist(), "semi_major": self.semi_major.T.tolist()}
+                "positions_m": self.positions.tolist(), "semi_major": self.semi_major.T.tolist(),
+                "shape": self.shape.T.tolist()}
 
 
 def mode_shapes(model, speed: float | None = None, n: int = 4, *, values=None) -> ModeShapes:
@@ -95,6 +104,7 @@ def mode_shapes(model, speed: float | None = None, n: int = 4, *, values=None) -
     U, V = md.shapes[iu].copy(), md.shapes[iv].copy()
     m = U.shape[1]
     major, minor = np.zeros((len(iu), m)), np.zeros((len(iu), m))
+    snap = np.zeros((len(iu), m))
     for r in range(m):
         big = np.concatenate([U[:, r], V[:, r]])
         k = int(np.argmax(np.abs(big)))
@@ -111,6 +121,13 @@ def mode_shapes(model, speed: float | None = None, n: int = 4, *, values=None) -
             V[:, r] /= top
             major[:, r] /= top
             minor[:, r] /= top
+        ref = int(np.argmax(major[:, r]))
+        alpha = ellipse(U[ref, r], V[ref, r]).angle
+        proj = U[:, r] * np.cos(alpha) + V[:, r] * np.sin(alpha)
+        if proj[ref] != 0:
+            snap[:, r] = (proj * np.conj(proj[ref]) / abs(proj[ref])).real
+        if np.max(np.abs(snap[:, r])) > 0:
+            snap[:, r] /= np.max(np.abs(snap[:, r]))
     return ModeShapes(md.speed, md.eigenvalues, md.frequencies_hz, md.damping_ratio,
                       log_decrement(md.eigenvalues), md.whirl, whirl_labels(md.whirl, md.frequencies_hz),
-                      np.asarray(model.positions, float), U, V, major, minor)
+                      np.asarray(model.positions, float), U, V, major, minor, snap)
