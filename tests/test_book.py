@@ -198,3 +198,14 @@ def test_variant_plant_default_is_thesis_plant():
     Pd = two_mass_variants.variant_plant(two_mass_variants.VariantSpec(zeta=0.02))
     zeta = -np.linalg.eigvals(Pd.A).real / np.abs(np.linalg.eigvals(Pd.A))
     np.testing.assert_allclose(zeta, 0.02, rtol=1e-9)
+
+
+@pytest.mark.slow
+def test_built_pages_fit_the_column(built_book):
+    """Every line of code and output of the built book, and every figure, fits the text column
+    (the checks of tests/test_book_width.py on the HTML, with the outputs the build produced)."""
+    from test_book_width import too_wide_built
+
+    html, _ = built_book
+    bad = too_wide_built(html)
+    assert not bad, "wider than the text column:\n" + "\n".join(bad)
