@@ -1,5 +1,5 @@
-"""Command-line interface: ``mutext diagnose``, ``mutext rig``, ``mutext frf``, ``mutext demo``, ``mutext check``
-and ``mutext grade``."""
+"""Command-line interface: ``mutext diagnose``, ``mutext rig``, ``mutext frf``, ``mutext rotor``, ``mutext demo``,
+``mutext check`` and ``mutext grade``."""
 from __future__ import annotations
 
 import argparse
@@ -73,6 +73,7 @@ COMMANDS = {
     "rig": ("mutext.commands.rig", "virtual rig: 'rig hide' writes a data set with a hidden effect"),
     "frf": ("mutext.commands.frf", "FRF files: 'frf convert' between mutext's CSV and Universal File data set 58, "
                                    "'frf resonances' the model-free resonance table of measured FRFs"),
+    "rotor": ("mutext.commands.rotor", "rotor model files: 'rotor campbell' the Campbell diagram and critical speeds"),
 }
 
 
@@ -187,13 +188,15 @@ def main(argv=None) -> int:
         # 'mutext help' is the overview, 'mutext help CMD' the command's own help
         argv = ["--help"] if len(argv) == 1 else [argv[1], "--help"]
     if not argv or argv[0] in ("-h", "--help"):
-        print("usage: mutext {diagnose,rig,frf,demo,check,grade,help} ...   (mutext --version)\n\n"
+        print("usage: mutext {diagnose,rig,frf,rotor,demo,check,grade,help} ...   (mutext --version)\n\n"
               "  diagnose MODEL.toml DATA.csv [...] [--validate VAL.csv ...] [--out DIR] [--json]\n"
               "                                     what the model gets wrong, why, and the gain once fixed\n"
               "  diagnose --batch DIR [--jobs N]    every data set under DIR, summary.csv and index.html\n"
               "  rig hide --seed N --out DIR        a data set with a hidden effect to diagnose\n"
               "  frf convert IN OUT                 FRF file CSV <-> Universal File 58 (.csv, .uff, .unv)\n"
               "  frf resonances FILE [...] [--json] resonances of measured FRFs: f_n, damping, channels\n"
+              "  rotor campbell MODEL.toml [--speeds 0:3000:31] [--plot FILE] [--json]\n"
+              "                                     Campbell diagram, log decrement, 1x/2x/3x critical speeds\n"
               "  demo NAME [options]                run a demonstration (mutext demo --list)\n"
               "  check EXERCISE FILE [--json]       does your exercise file run and return the right kinds of\n"
               "                                     values? (never whether they are right; mutext check --list)\n"
@@ -221,7 +224,7 @@ def main(argv=None) -> int:
         import os
         os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
         return 0
-    print(f"mutext: unknown command '{cmd}' (expected one of diagnose, rig, frf, demo, check, grade)", file=sys.stderr)
+    print(f"mutext: unknown command '{cmd}' (expected one of diagnose, rig, frf, rotor, demo, check, grade)", file=sys.stderr)
     return 2
 
 

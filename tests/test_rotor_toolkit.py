@@ -378,3 +378,30 @@ def test_rotor_figures_draw_the_results():
     fig5 = plots.orbit_figure([r.orbit(5), r.orbit(20, 1)])
     np.testing.assert_allclose(fig5.axes[1].lines[0].get_ydata(), 1e6 * r.orbit(20, 1).y)
     plt.close("all")
+
+
+# ----------------------------------------------------------------------------- command line
+
+def test_cli_rotor_campbell(capsys, tmp_path):
+    import json
+
+    from mutext.cli import main
+    from mutext.rotor import data_path
+    png = tmp_path / "campbell.png"
+    assert main(["rotor", "campbell", data_path("rotor.toml"), "--speeds", "900:1100:2", "--modes", "2",
+                 "--plot", str(png), "--json"]) == 0
+    out = json.loads(capsys.readouterr().out)
+    assert out["speeds_rpm"] == pytest.approx([900.0, 1100.0]) and png.stat().st_size > 10000
+    two = [c for c in out["crossings"] if c["order"] == 2 and c["whirl"] == "forward"]
+    assert len(two) == 1 and 1010 < two[0]["speed_rpm"] < 1025
+    lam, _ = _plain_modes(plain_rotor(), two[0]["speed_rad_s"], 2)       # the independent rotor there
+    assert lam[1].imag / (2 * np.pi) == pytest.approx(two[0]["frequency_hz"], rel=1e-6)
+    assert main(["rotor", "campbell", data_path("rotor.toml"), "--speeds", "900,1100", "--modes", "2"]) == 0
+    text = capsys.readouterr().out
+    assert "2x  mode 2  forward" in text and "rpm" in text
+    assert main(["rotor", "campbell", data_path("rotor.toml"), "--speeds", "3000:0:4"]) == 2
+    assert "--speeds" in capsys.readouterr().err
+    assert main(["rotor", "campbell", str(tmp_path / "none.toml")]) == 1
+    assert "no such model file" in capsys.readouterr().err
+    assert main(["rotor", "campbell", data_path("three_mass.toml"), "--speeds", "0,10"]) == 1
+    assert "two bending planes" in capsys.readouterr().err

@@ -1,0 +1,113 @@
+"""``mutext rotor campbell MODEL.toml --speeds 0:3000:31 [--modes N] [--orders 1,2,3] [--plot FILE] [--json]``.
+
+The Campbell diagram of a rotor model file (:func:`mutext.rotor.campbell`):
+the whirl frequencies of the lowest modes against speed, forward or backward,
+their logarithmic decrement, and the critical speeds where the excitation
+lines of the orders (1x unbalance, 2x and 3x a breathing crack) cross them.
+Speeds are given in rpm as ``START:STOP:COUNT`` (evenly spaced, both ends
+included) or as a comma-separated list.
+"""
+from __future__ import annotations
+
+import math
+
+
+def add_arguments(p):
+    sub = p.add_subparsers(dest="action", required=True)
+    c = sub.add_parser("campbell", help="Campbell diagram: whirl frequencies, log decrement and critical speeds",
+                       description="The Campbell diagram of a rotor model file: whirl frequencies of the lowest "
+                                   "modes against speed (forward/backward), their log decrement, and the critical "
+                                   "speeds where the 1x, 2x, 3x lines cross them.")
+    c.add_argument("model", metavar="MODEL.toml", help="rotor model file (two bending planes)")
+    c.add_argument("--speeds", default="0:3000:31", metavar="START:STOP:COUNT",
+                   help="speeds in rpm: START:STOP:COUNT (default 0:3000:31) or a list such as 0,500,1000")
+    c.add_argument("--modes", type=int, default=6, metavar="N", help="lowest modes kept at each speed (default 6)")
+    c.add_argument("--orders", default="1,2,3", help="excitation orders whose crossings are sought (default 1,2,3)")
+    c.add_argument("--refine", action="store_true", help="locate each critical speed on the eigenproblem "
+                                                          "(Brent's method) instead of interpolating")
+    c.add_argument("--plot", metavar="FILE", help="save the diagram as an image (PNG, SVG or PDF by extension)")
+    c.add_argument("--json", action="store_true", help="print the whole diagram as one JSON object")
+
+
+def parse_speeds(text: str):
+    """``"0:3000:31"`` or ``"0,500,1000"`` (rpm) -> list of float, or UsageError naming the option."""
+    from ..errors import UsageError
+    t = str(text).strip()
+    try:
+        if ":" in t:
+            parts = t.split(":")
+            if len(parts) != 3:
+                raise ValueError
+            a, b, n = float(parts[0]), float(parts[1]), int(parts[2])
+            if n < 2 or not (math.isfinite(a) and math.isfinite(b)) or b <= a:
+                raise ValueError
+            return [a + (b - a) * i / (n - 1) for i in range(n)]
+        vals = [float(x) for x in t.split(",") if x.strip()]
+        if not vals or not all(math.isfinite(v) for v in vals):
+            raise ValueError
+        return vals
+    except ValueError:
+        raise UsageError(f"--speeds {text!r}: expected START:STOP:COUNT in rpm with STOP > START and COUNT >= 2 "
+                         "(e.g. 0:3000:31), or a comma-separated list of speeds in rpm") from None
+
+
+def _orders(text: str):
+    from ..errors import UsageError
+    try:
+        out = [int(x) for x in str(text).split(",") if x.strip()]
+    except ValueError:
+        out = []
+    if not out or any(k < 1 for k in out):
+        raise UsageError(f"--orders {text!r}: expected positive integers separated by commas (e.g. 1,2,3)")
+    return out
+
+
+def run(args) -> int:
+    import os
+
+    from ..errors import ModelError, UsageError
+    from ..jsonio import print_json
+    from ..rotor import campbell, load_model, rpm_to_rad_s
+    speeds = parse_speeds(args.speeds)
+    orders = _orders(args.orders)
+    if args.modes < 1:
+        raise UsageError(f"--modes must be a positive integer, got {args.modes}")
+    if args.plot:
+        ext = os.path.splitext(args.plot)[1].lower()
+        if ext not in (".png", ".svg", ".pdf"):
+            raise UsageError(f"--plot {args.plot}: the extension must be .png, .svg or .pdf")
+        d = os.path.dirname(os.path.abspath(args.plot))
+        if not os.path.isdir(d):
+            raise ModelError(f"--plot {args.plot}: the directory {d} does not exist")
+    if not os.path.isfile(args.model):
+        raise ModelError(f"{args.model}: no such model file")
+    model = load_model(args.model)
+    cd = campbell(model, rpm_to_rad_s(speeds), args.modes, orders=orders, refine=args.refine)
+    if args.plot:
+        from .. import plots
+        from .._mpl import pyplot
+        fig = plots.campbell_figure(cd)
+        fig.savefig(args.plot, dpi=120)
+        pyplot().close(fig)
+    if args.json:
+        out = cd.to_dict()
+        if args.plot:
+            out["plot"] = args.plot
+        print_json(out)
+        return 0
+    print(f"Campbell diagram of {model.name}: {len(speeds)} speeds {speeds[0]:g}..{speeds[-1]:g} rpm, "
+          f"{args.modes} modes")
+    print(f"\n{'mode':>4} {'at ' + format(speeds[0], 'g') + ' rpm [Hz]':>18} {'at ' + format(speeds[-1], 'g') + ' rpm [Hz]':>18}"
+          f" {'whirl':>10} {'log dec':>9}")
+    for r in range(cd.frequencies_hz.shape[1]):
+        print(f"{r + 1:>4} {cd.frequencies_hz[0, r]:>18.3f} {cd.frequencies_hz[-1, r]:>18.3f} "
+              f"{cd.direction[-1][r]:>10} {cd.log_dec[-1, r]:>9.4f}")
+    print(f"\ncritical speeds (crossings of the {', '.join(f'{k}x' for k in orders)} lines"
+          f"{', refined' if args.refine else ', interpolated'}):")
+    if not cd.crossings:
+        print("  none in the speed range")
+    for c in cd.crossings:
+        print(f"  {c.order}x  mode {c.mode + 1:<2} {c.whirl:<10} {c.speed_rpm:10.1f} rpm  ({c.frequency_hz:.3f} Hz)")
+    if args.plot:
+        print(f"\nplot: {args.plot}")
+    return 0
