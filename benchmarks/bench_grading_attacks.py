@@ -35,7 +35,7 @@ HONEST = {"infinite_loop", "destabilizing", "missing_noise", "wrong_weight", "on
           "ex04_hz_and_pi", "ex04_lumped_mass", "ex04_missing_L", "ex04_no_supports", "ex05_hz_as_rad",
           "ex05_never_none", "ex05_unwrapped_phase", "ex05_zero_based", "ex06_centre_in_fit",
           "ex06_fixed_threshold", "ex06_rad_per_s", "ex07_negative_feedback", "ex07_hz", "ex07_shortcuts",
-          "ex07_stretch"}
+          "ex07_stretch", "ex08_plus_u", "ex08_no_wz", "ex08_whole_grid"}
 #: files that cheat on one question and answer the others honestly (their points come from those; the
 #: tests check that the cheated question scores 0)
 PART_CHEAT = {"cheat_in_functions", "ex02_cheat_mu", "ex04_cheat_rotor", "ex07_cheat_mu"}

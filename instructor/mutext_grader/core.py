@@ -238,6 +238,9 @@ EXERCISES = {
     "ex07_small_gain": ("mutext_grader.ex07_small_gain",
                         "M-Delta loop: M = F_l(P, K) of the two-mass springs, H-infinity norm and small-gain "
                         "margin, least destabilising Delta, mu bounds for a diagonal structure"),
+    "ex08_mbi": ("mutext_grader.ex08_mbi",
+                 "model-based identification on the three-mass rig: the plant of Fig. 3.3, D-K, the W_z rule, K "
+                 "read as mass, damper and spring on its identifiable band"),
 }
 
 

@@ -661,8 +661,68 @@ EX07 = ExerciseSpec(
                   "array of 2 numbers [lower, upper]", _ex07_d, array_rule(size=lambda a, k: 2))))
 
 
+# ----------------------------------------------------------------------------------------------------------
+# ex08: model-based identification on the three-mass rig
+# ----------------------------------------------------------------------------------------------------------
+
+def _three_mass_rig(rng):
+    """A plausible rig dictionary (three carts, one changed parameter on cart 3, ports, weights)."""
+    true = [_u(rng, 2.0, 3.0), _u(rng, 2.0, 3.0), _u(rng, 1.5, 3.0), _u(rng, 300.0, 900.0), _u(rng, 300.0, 900.0),
+            _u(rng, 150.0, 500.0), _u(rng, 1.0, 5.0), _u(rng, 1.0, 5.0), _u(rng, 5.0, 15.0)]
+    changed = str(rng.choice(["k3", "m3", "c3"]))
+    eng = list(true)
+    i = {"m3": 2, "k3": 5, "c3": 8}[changed]
+    eng[i] = float(f"{true[i] * rng.uniform(0.4, 0.8):.4g}")
+    return dict(true=true, engineering=eng, changed=changed, rel=_u(rng, 0.01, 0.03, 3), excitation=0,
+                measurement=0, control=2, Ww=1.0, eps_u=_u(rng, 0.05, 0.5, 3), eps_y=_u(rng, 1e-8, 1e-7, 3))
+
+
+def _ex08_grid(rng):
+    return np.round(np.logspace(-0.4, 2.5, int(rng.integers(60, 121))), 8).tolist()
+
+
+def _ex08_a(rng):
+    out = []
+    for _ in range(2):
+        rig = _three_mass_rig(rng)
+        rig.update(excitation=int(rng.integers(3)), measurement=int(rng.integers(3)), control=int(rng.integers(1, 3)))
+        out.append(([rig, _u(rng, 1e-4, 2e-3)], {}))
+    return out
+
+
+def _ex08_b(rng):
+    return [([_three_mass_rig(rng), _u(rng, 1e-3, 5e-3), _ex08_grid(rng)], {})]
+
+
+def _ex08_c(rng):
+    return [([_three_mass_rig(rng), _u(rng, 1e-4, 3e-4), _u(rng, 2e-3, 5e-3), _ex08_grid(rng)], {})]
+
+
+def _ex08_d(rng):
+    p = _u(rng, 50.0, 300.0)
+    K = _ss_arg([[-p, 0.0], [1.0, -p]], [[1.0], [0.0]], [[0.0, _u(rng, 1e5, 1e7)]], [[0.0]])
+    return [([_three_mass_rig(rng), _u(rng, 1e-4, 1e-3), K, _ex08_grid(rng)], {})]
+
+
+EX08 = ExerciseSpec(
+    "ex08_mbi", "Model-based identification on the three-mass rig: plant, D-K, the W_z rule, K",
+    "model-based identification on the three-mass rig: the plant of Fig. 3.3, D-K, the W_z rule, K read as "
+    "mass, damper and spring on its identifiable band",
+    "exercises/ex08_mbi.py", ("mutext.mbi", "mutext.diagnose", "mutext.hide", "mutext.commands"),
+    (QuestionSpec("a", "mbi_plant", "the plant of thesis Fig. 3.3", 3.0, "ss",
+                  "StateSpace or (A, B, C, D), continuous time, with 4 inputs [w_unc, w, n, u] and 4 outputs "
+                  "[z_unc, z, z_u, y]", _ex08_a, ss_rule(4, 4)),
+     QuestionSpec("b", "synthesize", "D-K: a controller with mu <= 1", 3.0, "ss",
+                  "StateSpace, continuous time, with 1 input (y) and 1 output (u)", _ex08_b, ss_rule(1, 1)),
+     QuestionSpec("c", "smallest_wz", "the W_z rule: the smallest Wz with mu <= 1", 2.0, "float", _FLOAT, _ex08_c,
+                  float_rule()),
+     QuestionSpec("d", "read_controller", "K read as mass, damper and spring on its identifiable band", 2.0,
+                  "array", "array of 5 numbers [dm, dc, dk, omega_lo, omega_hi]", _ex08_d,
+                  array_rule(size=lambda a, k: 5))))
+
+
 #: name -> ExerciseSpec, in course order
-EXERCISES = {ex.name: ex for ex in (EX01, EX02, EX03, EX04, EX05, EX06, EX07)}
+EXERCISES = {ex.name: ex for ex in (EX01, EX02, EX03, EX04, EX05, EX06, EX07, EX08)}
 
 
 def find_exercise(name: str) -> str | None:
