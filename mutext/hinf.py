@@ -873,7 +873,12 @@ class SlycotReference:
     seconds: float = 0.0
 
 
-def _slycot_child(P, nmeas, ncon, conn):
+def _slycot_child(P, nmeas, ncon, conn, cpu_seconds=None):
+    if cpu_seconds is not None:
+        import resource
+        soft = max(1, int(np.ceil(cpu_seconds)))
+        # SIGXCPU at the soft limit, SIGKILL one second of CPU later
+        resource.setrlimit(resource.RLIMIT_CPU, (soft, soft + 1))
     try:
         t0 = time.perf_counter()
         K, _, gam, _ = ct.hinfsyn(P, nmeas, ncon)
@@ -890,9 +895,12 @@ def slycot_hinfsyn(P, nmeas: int, ncon: int, timeout: float | None = 20.0,
 
     slycot (SB10AD) can take very long or never return on badly scaled or
     singular plants, so with ``timeout`` set it runs in a forked child process
-    that is killed after ``timeout`` seconds.  Its controller is then checked
-    the same way ours is: closed loop rebuilt from ``P`` and ``K``, stability,
-    norm recomputed by :func:`mutext.lti.hinf_norm`.
+    that is stopped once it has used ``timeout`` seconds of CPU time (the
+    operating system's CPU-time limit, so the outcome does not depend on how
+    busy the machine is; a child that waits without computing is stopped
+    after ``10 * timeout + 60`` seconds of wall-clock time).  Its controller is
+    then checked the same way ours is: closed loop rebuilt from ``P`` and
+    ``K``, stability, norm recomputed by :func:`mutext.lti.hinf_norm`.
     """
     import multiprocessing as mp
     P = as_ss(P, "P")
@@ -903,19 +911,24 @@ def slycot_hinfsyn(P, nmeas: int, ncon: int, timeout: float | None = 20.0,
         msg = parent.recv()
     else:
         parent, child = mp.Pipe(duplex=False)
-        proc = mp.get_context("fork").Process(target=_slycot_child, args=(P, nmeas, ncon, child))
+        import signal
+        proc = mp.get_context("fork").Process(target=_slycot_child, args=(P, nmeas, ncon, child, timeout))
         with warnings.catch_warnings():  # fork from a threaded process: the child only runs slycot
             warnings.simplefilter("ignore", DeprecationWarning)
             proc.start()
         child.close()
-        if not parent.poll(timeout):
+        if not parent.poll(10 * timeout + 60):
             proc.kill()
             proc.join()
-            return SlycotReference("timeout", note=f"no answer within {timeout:g} s",
+            return SlycotReference("timeout", note=f"no answer within {10 * timeout + 60:g} s (idle child)",
                                    seconds=time.perf_counter() - t0)
         try:
             msg = parent.recv()
         except EOFError:
+            proc.join()
+            if proc.exitcode in (-signal.SIGXCPU, -signal.SIGKILL):
+                return SlycotReference("timeout", note=f"no answer within {timeout:g} s of CPU time",
+                                       seconds=time.perf_counter() - t0)
             msg = ("error", f"slycot process died (exit code {proc.exitcode})", None, 0.0)
         proc.join()
     status, gam, mats, sec = msg

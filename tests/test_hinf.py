@@ -104,7 +104,9 @@ def test_singular_d12_solved_by_lmi():
     D0 = D.copy()
     D0[1, 2] = 0.0                       # z2 = 0 * u
     P = ss(A, B, C, D0)
-    ref = slycot_hinfsyn(P, 1, 1, timeout=10)   # slycot refuses (or never returns on) this problem
+    # slycot refuses (or never returns on) this problem; the limit is on its CPU time (the
+    # regularised problems below need about 0.1 s of it), so a busy machine does not change the outcome
+    ref = slycot_hinfsyn(P, 1, 1, timeout=2)
     assert ref.status in ("error", "timeout")
     res = hinfsyn(P, 1, 1)
     assert any("D12 does not have full column rank" in n for n in res.notes)
