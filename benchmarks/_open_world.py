@@ -906,7 +906,10 @@ def claimed_data(chain: Chain, effects):
     of the whole structure: ``damping_scale`` (the chain's own damping times :math:`1 + a`, ``value`` =
     :math:`a`; elements changed or added by other effects are not scaled), ``frequency_scale`` (the structure's
     response at :math:`f(1 + \\epsilon)` labelled :math:`f`, ``value`` = :math:`\\epsilon`) and ``sensor_mass``
-    (a mass ``value`` [kg] at each channel's own output mass).
+    (a mass ``value`` [kg] at each channel's own output mass); kinds with an added degree of freedom or a run:
+    ``absorber`` (``values`` = m_a, k_a, c_a: :func:`with_absorber` at mass ``station``), ``pedestal``
+    (``values`` = m_p, k_p: the grounded spring ``element`` moved onto a mass m_p, held by k_p to ground)
+    and ``distributed_stiffness`` (every spring named in ``run`` times 1 + ``value``).
     """
     M, C, K = chain.matrices()
     st = _State(M, C, K)
@@ -946,6 +949,25 @@ def claimed_data(chain: Chain, effects):
             st = replace(st, eps=st.eps + v)
         elif kind == "sensor_mass":
             st = replace(st, sensor_mass=st.sensor_mass + v)
+        elif kind == "absorber":        # one more DOF: mass m_a tied to the mass ``station`` by k_a and c_a
+            ma, ka, ca = (float(x) for x in get(e, "values"))
+            st = replace(st, **dict(zip("MCK", with_absorber(st.M, st.C, st.K, int(station) - 1, ma, ka, ca))))
+        elif kind == "pedestal":        # the grounded spring ``element`` ends on a mass m_p held by k_p
+            mp, kp = (float(x) for x in get(e, "values"))
+            el = next(x for x in chain.springs if x["name"] == element)
+            i = chain.index(next(b for b in el["between"] if b != "ground"))
+            Mx, Cx, Kx = with_absorber(st.M, st.C, st.K, i, mp, el["value"], 0.0)
+            Kx[i, i] -= el["value"]
+            Kx[-1, -1] += kp
+            st = replace(st, M=Mx, C=Cx, K=Kx)
+        elif kind == "distributed_stiffness":    # every spring of the run ``run`` times (1 + value)
+            Kx = st.K.copy()
+            for name in get(e, "run"):
+                el = next(x for x in chain.springs if x["name"] == name)
+                P = np.zeros_like(Kx)
+                P[:n, :n] = chain.pattern(el["between"])
+                Kx += v * el["value"] * P
+            st = replace(st, K=Kx)
         else:
             raise ValueError(f"claimed_data: no physics here for an effect of kind {kind!r}")
     return _linear(chain, st)

@@ -167,7 +167,9 @@ def effects_of(d) -> list:
 def finding_row(f) -> dict:
     return {"kind": f.kind, "station": f.station, "element": f.element, "value": float(f.value),
             "std": float(getattr(f, "std", math.nan)), "unit": getattr(f, "unit", ""),
-            "at_bound": bool(getattr(f, "at_bound", False))}
+            "at_bound": bool(getattr(f, "at_bound", False)),
+            **({"values": [float(x) for x in f.values]} if getattr(f, "values", None) is not None else {}),
+            **({"run": list(f.hypothesis.run)} if getattr(getattr(f, "hypothesis", None), "run", ()) else {})}
 
 
 def size_error(e: dict, f) -> float:

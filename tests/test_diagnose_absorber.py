@@ -82,3 +82,34 @@ def test_a_loss_shared_by_every_spring_is_found_as_a_distributed_change(tmp_path
     ext = load_model(d.extended_model)
     errs = [np.abs(np.log(model_response(ext, frf) / clean)) for frf, clean in zip(case.measured, case.clean)]
     assert float(np.sqrt(np.mean(np.concatenate(errs) ** 2))) < 0.3 * NOISE
+
+
+def test_a_grounded_spring_on_a_pedestal_is_found_sized_and_written(tmp_path):
+    """The three-mass rig's spring k3 (m3 to ground) set on a pedestal (mass m_p, spring k_p to ground),
+    built with the independent generator's matrices: an added DOF, k3 moved onto it."""
+    import _open_world as ow
+    path = ow.example_path("three_mass")
+    chain = ow.read_chain(path)
+    M, C, K = chain.matrices()
+    k3 = next(s for s in chain.springs if s["name"] == "k3")
+    i = chain.index(k3["between"][0])
+    mp, kp = 1.0, 3.0 * k3["value"]
+    Mp, Cp, Kp = ow.with_absorber(M, C, K, i, mp, k3["value"], 0.0)     # m_p tied to m3 by k3 ...
+    Kp[i, i] -= k3["value"]                                             # ... k3 no longer to ground ...
+    Kp[-1, -1] += kp                                                    # ... the pedestal held by k_p
+    data = ow._linear(chain, ow._State(Mp, Cp, Kp))
+    meas_ch, val_ch = ow.channels(chain)
+    f = ow.band_grid(M, K)
+    rng = np.random.default_rng(11)
+    measured = ow._frfs(chain, data, meas_ch, f, NOISE, rng, "measured")
+    validate = ow._frfs(chain, data, val_ch, f + 0.5 * (f[1] - f[0]), NOISE, rng, "validate")
+    d = diagnose(path, measured, validate=validate, out_dir=tmp_path)
+    assert d.status == "explained" and d.confirmed, d.report()
+    assert [(e.kind, e.station, e.element) for e in d.effects] == [("pedestal", i + 1, "k3")], d.report()
+    e = d.effects[0]
+    for v, sd, t in zip(e.values, e.stds, (mp, kp)):
+        assert abs(v - t) <= 3 * sd and sd < 0.2 * t, (v, sd, t)
+    ext = load_model(d.extended_model)
+    clean = data(meas_ch, f)
+    errs = [np.abs(np.log(model_response(ext, frf) / h)) for frf, h in zip(measured, clean)]
+    assert float(np.sqrt(np.mean(np.concatenate(errs) ** 2))) < 0.3 * NOISE

@@ -375,3 +375,43 @@ def test_every_out_of_library_effect_is_detectable_and_distinct(example):
         assert abs(_rms_log([m.response for m in case.measured], case.clean) / NOISE - 1) < 0.1, kind
         assert case.key["single_fit"]["misfit"] >= ow.DISTINCT, (kind, case.key["single_fit"])
         assert case.key["effects"] == [] and case.key["category"] == "out_of_library"
+
+
+def test_claims_with_an_added_dof_or_a_run_reproduce_the_systems_they_name():
+    """claimed_data's absorber, pedestal and distributed stiffness against the generator's own draws of the
+    same systems (tuned absorber, every-spring loss) and against a split spring to ground (a pedestal)."""
+    case = ow.make_case("three_mass", "out_of_library", "tuned_absorber", 0, 0.01)
+    det = case.key["details"]
+    ma = det["value"]
+    ka = ma * (2 * np.pi * det["tuned_hz"]) ** 2
+    ca = 2 * det["zeta"] * np.sqrt(ka * ma)
+    claim = {"kind": "absorber", "station": det["station"], "element": None, "value": ma, "values": [ma, ka, ca]}
+    assert ow.equivalence_error(case, [claim])["error"] < 1e-10
+    assert ow.equivalence_error(case, [{**claim, "values": [ma, 1.02 * ka, ca]}])["error"] > 1e-3
+    case = ow.make_case("four_story", "out_of_library", "stiffness_loss", 0, 0.01)
+    run = [s["name"] for s in ow.read_chain(case.model_path).springs]
+    claim = {"kind": "distributed_stiffness", "station": 1, "element": "..", "value": -case.key["details"]["value"],
+             "run": run}
+    assert ow.equivalence_error(case, [claim])["error"] < 1e-10
+    assert ow.equivalence_error(case, [{**claim, "run": run[1:]}])["error"] > 1e-3
+    # a pedestal (m_p, k_p) under k3 is the chain with k3 ending on a mass m_p held by k_p; the split spring
+    # k3 -> 2 k3 - mx - 2 k3 - ground is an absorber at m3 (m_a = mx / 4, k_a = k3, no damper) on the model
+    from dataclasses import replace as _replace
+    chain = ow.read_chain(ow.example_path("three_mass"))
+    k3 = next(s for s in chain.springs if s["name"] == "k3")
+    meas_ch, _ = ow.channels(chain)
+    f = ow.band_grid(*[chain.matrices()[k] for k in (0, 2)])
+
+    def split(ka, kb, mx):
+        springs = [dict(s) for s in chain.springs if s["name"] != "k3"] + [
+            {"name": "k3a", "between": (k3["between"][0], "mx"), "value": ka},
+            {"name": "k3b", "between": ("mx", "ground"), "value": kb}]
+        return ow._linear(chain, ow._State(*_replace(chain, masses=chain.masses + [("mx", mx)],
+                                                     springs=springs).matrices()))(meas_ch, f)
+    mp, kp = 0.7, 2.5 * k3["value"]
+    claimed = ow.claimed_data(chain, [{"kind": "pedestal", "station": 3, "element": "k3", "value": mp,
+                                       "values": [mp, kp]}])
+    assert ow.rms_log_change(claimed(meas_ch, f), split(k3["value"], kp, mp)) < 1e-10
+    claimed = ow.claimed_data(chain, [{"kind": "absorber", "station": 3, "element": None, "value": mp / 4,
+                                       "values": [mp / 4, k3["value"], 0.0]}])
+    assert ow.rms_log_change(claimed(meas_ch, f), split(2 * k3["value"], 2 * k3["value"], mp)) < 1e-10

@@ -12,6 +12,7 @@ from .faults import channel as _channel
 from .faults import crack as _crack
 from .faults import distributed as _distributed
 from .faults import lumped as _lumped
+from .faults import pedestal as _pedestal
 from .faults import rotor as _rotor
 from .faults import structure as _structure
 from .faults._base import Hypothesis
@@ -19,8 +20,8 @@ from .faults._base import Hypothesis
 __all__ = ["KINDS", "Hypothesis", "hypotheses", "write_finding"]
 
 #: Kinds of finding (the ``kind`` field of :class:`~mutext.diagnose.Finding`).
-KINDS = (("stiffness", "mass", "damping", "crack", "bearing") + _absorber.KINDS + _distributed.KINDS + _channel.KINDS
-         + _structure.KINDS + ("none",))
+KINDS = (("stiffness", "mass", "damping", "crack", "bearing") + _absorber.KINDS + _distributed.KINDS
+         + _pedestal.KINDS + _channel.KINDS + _structure.KINDS + ("none",))
 
 
 def hypotheses(model, frfs=None, *, stations=None) -> list[Hypothesis]:
@@ -28,7 +29,8 @@ def hypotheses(model, frfs=None, *, stations=None) -> list[Hypothesis]:
     if isinstance(model, (str, os.PathLike)):
         model = load_model(model)
     if model.layout.kind == "lumped":
-        hyps = _lumped.candidates(model) + _distributed.candidates(model) + _absorber.candidates(model)
+        hyps = (_lumped.candidates(model) + _distributed.candidates(model) + _absorber.candidates(model)
+                + _pedestal.candidates(model))
     else:
         hyps = _rotor.candidates(model, stations) + _crack.candidates(model, stations)
     if frfs is not None:
@@ -44,6 +46,8 @@ def write_finding(mf, finding, model, note: str) -> None:
         home = _absorber
     elif h.kind == "distributed_stiffness":
         home = _distributed
+    elif h.kind == "pedestal":
+        home = _pedestal
     elif model.layout.kind == "lumped":
         home = _lumped
     else:

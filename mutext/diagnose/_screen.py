@@ -228,7 +228,21 @@ def _fit_vector(ev: _Evaluator, s2: float, n_best: int = 3):
     ranked = sorted(((float(np.sum(resid(x) ** 2)), k) for k, x in enumerate(starts)))
     best = None
     for _, k in ranked[:n_best]:
-        sol = so.least_squares(resid, starts[k], bounds=(lo, hi), method="trf", x_scale=1.0, max_nfev=200)
+        # a lightly damped resonance of the added part is a narrow valley: its frequency first, by the first
+        # parameter alone (a mass, at the others held), within 10 % either side of the start
+        x = starts[k].copy()
+
+        def along(v, x=x):
+            y = x.copy()
+            y[0] = v
+            return float(np.sum(resid(y) ** 2))
+        a, b = max(x[0] - 0.2, lo[0]), min(x[0] + 0.2, hi[0])
+        if b > a:
+            r1 = so.minimize_scalar(along, bounds=(a, b), method="bounded", options={"xatol": 1e-8})
+            if r1.fun < along(x[0]):
+                x[0] = float(r1.x)
+        sol = so.least_squares(resid, x, bounds=(lo, hi), method="trf", x_scale="jac", max_nfev=1000,
+                               ftol=1e-12, xtol=1e-12)
         rss = float(np.sum(sol.fun ** 2))
         if best is None or rss < best[1]:
             best = (sol.x, rss, sol.jac)
