@@ -7,3 +7,53 @@ import numpy  # noqa: F401  (loads OpenBLAS first: threadpoolctl limits only lib
 from threadpoolctl import threadpool_limits
 
 _limits = threadpool_limits(limits=1, user_api="blas")
+
+
+# ---------------------------------------------------------------------------
+# parallel runs (pytest-xdist; pyproject's addopts: -n auto --dist loadgroup)
+# ---------------------------------------------------------------------------
+
+import os  # noqa: E402
+
+import pytest  # noqa: E402
+
+# modules whose tests run confined grading children (as root: tmpfs, mount namespaces, the
+# unprivileged user) and check afterwards that /tmp, /var/tmp, /dev/shm and the shared memory are as
+# they found them: one worker runs them all, so no other grading child is alive during those checks
+_GRADING = ("test_grading", "test_gradescope")
+
+
+def _cpus() -> int:
+    """The CPUs this process may use: its affinity mask, capped by a cgroup v2 CPU quota."""
+    n = len(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity") else (os.cpu_count() or 1)
+    try:
+        quota, period = open("/sys/fs/cgroup/cpu.max").read().split()
+        if quota != "max":
+            n = min(n, max(1, -(-int(quota) // int(period))))
+    except (OSError, ValueError):
+        pass
+    return max(1, n)
+
+
+@pytest.hookimpl(optionalhook=True)
+def pytest_xdist_auto_num_workers(config):
+    """``-n auto``: one worker per usable CPU, none (the tests run in this process) on a single CPU.
+    PYTEST_XDIST_AUTO_NUM_WORKERS still decides when it is set."""
+    env = os.environ.get("PYTEST_XDIST_AUTO_NUM_WORKERS")
+    if env:
+        return int(env)
+    n = _cpus()
+    return 0 if n == 1 else n
+
+
+@pytest.hookimpl(tryfirst=True)
+def pytest_collection_modifyitems(config, items):
+    """Scheduling unit of ``--dist loadgroup``: a test module (its module-scoped fixtures are built
+    once, its tests never race each other), all grading modules together (see ``_GRADING``), or the
+    group a test names itself with ``@pytest.mark.xdist_group``."""
+    for item in items:
+        if item.get_closest_marker("xdist_group") is not None:
+            continue
+        module = item.nodeid.split("::", 1)[0]
+        name = "grading" if os.path.basename(module).startswith(_GRADING) else module
+        item.add_marker(pytest.mark.xdist_group(name))
