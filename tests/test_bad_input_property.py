@@ -55,15 +55,17 @@ def _time_bound(seconds: float):
         yield
         return
 
+    # a limit on this process's CPU time (ITIMER_PROF), not on wall-clock time: a hang computes, and
+    # a busy machine slows the clock down, not the count
     def on_alarm(signum, frame):
-        raise Hang(f"no answer within {seconds} s")
-    old = signal.signal(signal.SIGALRM, on_alarm)
-    signal.setitimer(signal.ITIMER_REAL, seconds)
+        raise Hang(f"no answer within {seconds} s of CPU time")
+    old = signal.signal(signal.SIGPROF, on_alarm)
+    signal.setitimer(signal.ITIMER_PROF, seconds)
     try:
         yield
     finally:
-        signal.setitimer(signal.ITIMER_REAL, 0)
-        signal.signal(signal.SIGALRM, old)
+        signal.setitimer(signal.ITIMER_PROF, 0)
+        signal.signal(signal.SIGPROF, old)
 
 
 def call(name: str, fn, *args, seconds: float = 60.0, **kw):

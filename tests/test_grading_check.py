@@ -46,9 +46,9 @@ def _json_without_seconds(report):
 def test_sample_calls_are_fresh_cheap_and_json():
     import time
     for ex in EXERCISES.values():
-        t0 = time.perf_counter()
+        t0 = time.process_time()        # CPU time: the same on a busy machine
         a = [q.sample_calls(np.random.default_rng(1)) for q in ex.questions]
-        assert time.perf_counter() - t0 < 2.0, ex.name
+        assert time.process_time() - t0 < 2.0, ex.name
         b = [q.sample_calls(np.random.default_rng(2)) for q in ex.questions]
         for q, ca, cb in zip(ex.questions, a, b):
             assert ca and all(isinstance(args, list) and isinstance(kw, dict) for args, kw in ca), (ex.name, q.id)

@@ -144,9 +144,9 @@ def test_returned_values_are_capped_in_size():
     assert not ok("float", 10 ** 400) and not ok("float", True)
     # the forged 1500-state controller is turned down at once, without a look at its numbers
     huge = _ss(1500)
-    t0 = time.perf_counter()
+    t0 = time.process_time()            # CPU time: the same on a busy machine
     assert sandbox._clean_calls("ss", [{"ok": True, "value": huge}], 1)[0]["ok"] is False
-    assert time.perf_counter() - t0 < 0.5
+    assert time.process_time() - t0 < 0.5
 
 
 def test_overlong_lines_on_the_channel_are_skipped_unread(tmp_path):
