@@ -29,7 +29,7 @@ so that ``M = F_l(P, K) = P11 + P12 K (I - P22 K)^-1 P21`` for the plant
 stable for every stable ``Delta`` with ``||Delta||_inf < 1/||M||_inf``
 (small gain, Zhou, Doyle & Glover, *Robust and Optimal Control*, thm. 9.1);
 for the diagonal (structured) ``Delta`` the margin is ``1/sup mu(M(jw))``,
-never smaller.  Book chapters: robust stability (the M-Delta loop) and
+never smaller.  Book chapters: "Robust stability and performance" and
 "Structured singular value".
 
 Rules
