@@ -17,7 +17,14 @@ Prints
    static correction at several cutoffs, and balanced truncation at several
    orders against SLICOT ``AB09AD`` (``control.balred``): Hankel singular
    values, H-infinity error, a-priori bound, relative error on 20-225 Hz;
-5. tuning to virtual sine sweeps (``mutext.rig.measure``, 411 points per
+5. modal analysis at speed: the dense eigen-solve of the first-order system
+   (``Rotor.modes``) against the sparse shift-invert Arnoldi solve of the
+   lowest modes (``mutext.rotor.sparse_modal.sparse_modes``, ARPACK through
+   ``scipy.sparse.linalg.eigs``) on the thesis rotor and on uniform shafts of
+   48 to 192 Timoshenko elements with two disks and two bearings, with the
+   largest relative difference of the frequencies; and a Campbell diagram
+   of the thesis rotor (31 speeds);
+6. tuning to virtual sine sweeps (``mutext.rig.measure``, 411 points per
    channel): bearing stiffness and density from 1 % noisy data, the crack
    depth ratio, and the thesis hand tuning (density and disk weight), with
    the recovered values, standard uncertainties, iterations and seconds.
@@ -56,6 +63,7 @@ def main(argv=None) -> int:
     ap.add_argument("--repeat", type=int, default=20, help="repetitions per timing (default 20)")
     ap.add_argument("--skip-reduction", action="store_true", help="leave out the model-reduction section")
     ap.add_argument("--skip-tuning", action="store_true", help="leave out the tuning section")
+    ap.add_argument("--skip-modal", action="store_true", help="leave out the dense/sparse modal section")
     args = ap.parse_args(argv)
     from mutext.rotor import data_path, load_model
     from mutext.rotor.analysis import blas_single_thread
@@ -109,10 +117,50 @@ def main(argv=None) -> int:
     if not args.skip_reduction:
         print()
         bench_reduction(th)
+    if not args.skip_modal:
+        print()
+        bench_modal(th, max(3, args.repeat // 4))
     if not args.skip_tuning:
         print()
         bench_tuning(th)
     return 0
+
+
+def uniform_rotor(n_el):
+    """A 1.5 m, 50 mm steel shaft in ``n_el`` Timoshenko elements, disks at 1/3 and 2/3, bearings at the ends
+    (Friswell et al.'s example 5.9.1 meshed finer)."""
+    from mutext.rotor import BearingElement, DiskElement, Param, Rotor, ShaftElement
+    E, G, rho = 211e9, 81.2e9, 7810.0
+    mat = dict(E=Param("E", E, "Pa"), G=Param("G", G, "Pa"), rho=Param("rho", rho, "kg/m^3"))
+    els = [ShaftElement(i, 1.5 / n_el, 0.05, 0.0, **mat) for i in range(1, n_el + 1)]
+    els += [DiskElement.from_geometry(n_el // 3 + 1, 0.07, 0.28, 0.05, rho),
+            DiskElement.from_geometry(2 * n_el // 3 + 1, 0.07, 0.35, 0.05, rho)]
+    els += [BearingElement(1, 1e6, 100.0), BearingElement(n_el + 1, 1e6, 100.0)]
+    return Rotor(els, name=f"uniform shaft, {n_el} elements")
+
+
+def bench_modal(th, repeat):
+    """Section 5: dense against sparse shift-invert modal analysis at speed."""
+    from mutext.rotor import campbell
+    from mutext.rotor.sparse_modal import sparse_modes
+    from mutext.rotor.units import rpm_to_rad_s
+    n = 6
+    speed = rpm_to_rad_s(3000.0)
+    print(f"modal analysis at 3000 rpm, lowest {n} modes: dense first-order eigen-solve (Rotor.modes) "
+          "vs sparse shift-invert (sparse_modes)")
+    print(f"{'model':<34} {'DOFs':>5} {'dense [s]':>10} {'sparse [s]':>11} {'speed-up':>9} {'max rel. diff':>14}")
+    for m in [th] + [uniform_rotor(k) for k in (48, 96, 192)]:
+        m.matrices()                                          # the build and modal damping, not timed
+        t_d = median_time(lambda: m.modes(speed=speed, n=n), repeat)
+        t_s = median_time(lambda: sparse_modes(m, speed, n), repeat)
+        a = m.modes(speed=speed, n=n).frequencies_hz
+        b = sparse_modes(m, speed, n).frequencies_hz
+        print(f"{m.name[:34]:<34} {m.ndof:>5} {t_d:>10.4f} {t_s:>11.4f} {t_d / t_s:>9.1f} "
+              f"{np.max(np.abs(b / a - 1)):>14.1e}")
+    speeds = rpm_to_rad_s(np.linspace(0.0, 3000.0, 31))
+    for method in ("dense", "sparse"):
+        t_c = median_time(lambda: campbell(th, speeds, 4, method=method), 1)
+        print(f"Campbell diagram of the thesis rotor, 31 speeds, 4 modes ({method}): {t_c:.2f} s")
 
 
 def bench_reduction(th):

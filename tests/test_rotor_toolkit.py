@@ -3,6 +3,7 @@ unbalance response (Bode/polar), orbits, against closed forms and against the in
 rotor of ``tests/rotor_plain.py``."""
 from __future__ import annotations
 
+import functools
 import math
 
 import casadi as ca
@@ -11,7 +12,7 @@ import pytest
 import scipy.linalg as sla
 
 from mutext.errors import ModelError
-from mutext.examples.cracked_rotor import healthy_rotor
+from mutext.examples.cracked_rotor import healthy_rotor as _healthy_rotor
 from mutext.rotor import BearingElement, DiskElement, Element, Rotor
 from mutext.rotor.campbell_diagram import campbell
 from mutext.rotor.modal import mode_shapes
@@ -19,7 +20,19 @@ from mutext.rotor.orbits import ellipse, orbit
 from mutext.rotor.unbalance import run_up, unbalance_response
 from mutext.rotor.units import rpm_to_rad_s
 
-from rotor_plain import plain_rotor
+from rotor_plain import plain_rotor as _plain_rotor
+
+
+@functools.lru_cache(maxsize=None)
+def healthy_rotor():
+    """The thesis rotor (built once: the analyses below do not change it)."""
+    return _healthy_rotor()
+
+
+@functools.lru_cache(maxsize=None)
+def plain_rotor():
+    """The independently written thesis rotor (built once)."""
+    return _plain_rotor()
 
 
 # ----------------------------------------------------------------------------- small rotors with closed forms
@@ -405,3 +418,25 @@ def test_cli_rotor_campbell(capsys, tmp_path):
     assert "no such model file" in capsys.readouterr().err
     assert main(["rotor", "campbell", data_path("three_mass.toml"), "--speeds", "0,10"]) == 1
     assert "two bending planes" in capsys.readouterr().err
+
+
+# ----------------------------------------------------------------------------- sparse modal solve
+
+def test_sparse_modes_against_plain_rotor():
+    from mutext.rotor.sparse_modal import sparse_modes
+    model, rot = healthy_rotor(), plain_rotor()
+    W = rpm_to_rad_s(2500.0)
+    md = sparse_modes(model, W, 6)
+    lam, _ = _plain_modes(rot, W, 6)
+    np.testing.assert_allclose(md.eigenvalues, lam, rtol=1e-8)
+    assert md.whirl_direction() == ["backward", "forward"] * 3
+    # a shift near the second pair finds it first
+    md2 = sparse_modes(model, W, 2, shift_hz=190.0)
+    np.testing.assert_allclose(md2.eigenvalues, lam[2:4], rtol=1e-8)
+    with pytest.raises(ModelError, match="shift_hz"):
+        sparse_modes(model, W, 2, shift_hz="x")
+    # the Campbell diagram on the sparse solve: the same critical speeds as the plain rotor's frequencies
+    cd = campbell(model, rpm_to_rad_s([900.0, 1100.0]), 2, method="sparse", refine=True)
+    two = cd.critical_speeds(order=2)[0]
+    lam, _ = _plain_modes(rot, two.speed, 2)
+    assert lam[1].imag == pytest.approx(2 * two.speed, rel=1e-8)

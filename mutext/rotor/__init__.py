@@ -29,6 +29,8 @@ modal
     :func:`mode_shapes`: the modes at a speed along the shaft, with log decrement and whirl.
 unbalance
     :func:`unbalance_response`: steady 1x response to unbalance at probes (Bode, polar), run-up.
+sparse_modal
+    :func:`sparse_modes`: the lowest modes at speed by shift-invert Arnoldi (fine meshes).
 periodic_orbit
     :func:`periodic_unbalance_response`: weight and unbalance on a rotor with a breathing
     crack, every order of the steady response (the 2x inner loop of the orbit).
@@ -73,6 +75,7 @@ from .modal import ModeShapes, mode_shapes
 from .orbits import Ellipse, Orbit, ellipse, orbit
 from .unbalance import UnbalanceResponse, run_up, unbalance_response
 from .periodic_orbit import PeriodicResponse, periodic_unbalance_response
+from .sparse_modal import sparse_modes
 from .units import rad_s_to_rpm, rpm_to_rad_s
 from .reduction import Reduction, balanced_truncation, hankel_singular_values, modal_truncation, reduction_error
 from .tuning import FRFSensitivity, TuneResult, frf_sensitivity, model_response, tune
@@ -88,7 +91,7 @@ __all__ = [
     "FRFSensitivity", "TuneResult", "frf_sensitivity", "model_response", "tune",
     "CampbellDiagram", "Crossing", "campbell", "ModeShapes", "mode_shapes", "Ellipse", "Orbit", "ellipse", "orbit",
     "UnbalanceResponse", "run_up", "unbalance_response", "rpm_to_rad_s", "rad_s_to_rpm",
-    "PeriodicResponse", "periodic_unbalance_response",
+    "PeriodicResponse", "periodic_unbalance_response", "sparse_modes",
 ]
 
 

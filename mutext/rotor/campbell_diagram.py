@@ -51,6 +51,7 @@ import numpy as np
 from ..errors import ModelError
 from ..lti import blas_single_thread
 from .analysis import _check_n, _values, modes
+from .sparse_modal import sparse_modes
 
 __all__ = ["CampbellDiagram", "Crossing", "campbell", "log_decrement", "whirl_labels", "speed_grid"]
 
@@ -172,7 +173,7 @@ def _orders(orders) -> tuple:
 
 
 def campbell(model, speeds: Sequence[float], n_modes: int = 6, *, orders: Sequence[int] = (1, 2, 3),
-             values=None, refine: bool = False) -> CampbellDiagram:
+             values=None, refine: bool = False, method: str = "dense") -> CampbellDiagram:
     """Campbell diagram of a two-plane rotor: frequencies, whirl, log decrement and critical speeds.
 
     Parameters
@@ -191,6 +192,11 @@ def campbell(model, speeds: Sequence[float], n_modes: int = 6, *, orders: Sequen
     refine : bool
         Locate each crossing by Brent's method on the eigenvalue problem
         (a few extra eigen-solves per crossing) instead of linear interpolation.
+    method : {"dense", "sparse"}
+        ``"dense"``: every mode of the first-order system
+        (:func:`mutext.rotor.analysis.modes`); ``"sparse"``: the ``n_modes`` lowest by
+        shift-invert Arnoldi (:func:`mutext.rotor.sparse_modal.sparse_modes`), faster on
+        fine meshes (``benchmarks/bench_rotor.py``).
 
     Returns
     -------
@@ -212,6 +218,8 @@ def campbell(model, speeds: Sequence[float], n_modes: int = 6, *, orders: Sequen
                          "planes (planes = 2): whirl is the motion in both")
     s = speed_grid(speeds, model.name)
     n = _check_n(n_modes, "n_modes")
+    if method not in ("dense", "sparse"):
+        raise ModelError(f"{model.name}: method must be 'dense' or 'sparse', got {method!r}")
     ords = _orders(orders)
     v = _values(model, values)
     with blas_single_thread():
@@ -219,8 +227,13 @@ def campbell(model, speeds: Sequence[float], n_modes: int = 6, *, orders: Sequen
     F = np.full((s.size, n), np.nan)
     Z, D, W = (np.full((s.size, n), np.nan) for _ in range(3))
     labels = []
+    def solve(om, m):
+        if method == "sparse":
+            return sparse_modes(model, om, m, values=v)
+        return modes(model, speed=om, matrices=mats, n=m)
+
     for i, om in enumerate(s):
-        md = modes(model, speed=om, matrices=mats, n=n)
+        md = solve(om, n)
         m = md.frequencies_hz.size
         F[i, :m], Z[i, :m], W[i, :m] = md.frequencies_hz, md.damping_ratio, md.whirl
         D[i, :m] = log_decrement(md.eigenvalues)
@@ -228,8 +241,7 @@ def campbell(model, speeds: Sequence[float], n_modes: int = 6, *, orders: Sequen
     cd = CampbellDiagram(s, F, Z, D, W, labels, ords, name=model.name)
 
     def g_at(om, r, k):
-        md = modes(model, speed=om, matrices=mats, n=r + 1)
-        return md.frequencies_hz[r] - k * om / (2 * np.pi)
+        return solve(om, r + 1).frequencies_hz[r] - k * om / (2 * np.pi)
 
     for k in ords:
         for r in range(n):

@@ -131,3 +131,4 @@ def mode_shapes(model, speed: float | None = None, n: int = 4, *, values=None) -
     return ModeShapes(md.speed, md.eigenvalues, md.frequencies_hz, md.damping_ratio,
                       log_decrement(md.eigenvalues), md.whirl, whirl_labels(md.whirl, md.frequencies_hz),
                       np.asarray(model.positions, float), U, V, major, minor, snap)
+
