@@ -43,7 +43,7 @@ MARK = "zz_mutext_hostile_marker"
 #: graded in tests/test_grading_resources.py, as root and as a plain user, with the machine checked after
 RESOURCE_ATTACKS = {"ex03_resources"}
 SUBMISSIONS = {p.stem: p for p in sorted(HOSTILE.glob("ex0*.py")) if p.stem not in RESOURCE_ATTACKS}
-EXERCISES = {"ex01": "ex01_two_mass_hinf", "ex03": "ex03_free_decay", "ex04": "ex04_beam_element"}
+EXERCISES = {"ex01": "ex01_two_mass_hinf", "ex03": "ex03_free_decay", "ex04": "ex04_beam_element", "ex08": "ex08_mbi"}
 
 _pool = ThreadPoolExecutor(max_workers=2)
 _futures = {}
@@ -92,7 +92,7 @@ def test_hostile_submission_scores_zero(name):
         assert rep.isolation == "uid", rep.isolation_details
 
 
-@pytest.mark.parametrize("name", ["ex01_frames", "ex03_frames", "ex04_frames", "ex03_gc"])
+@pytest.mark.parametrize("name", ["ex01_frames", "ex03_frames", "ex04_frames", "ex08_frames", "ex03_gc"])
 def test_switching_off_the_audit_hook_does_not_reach_the_solutions(name):
     rep = graded(name)
     assert all("No module named 'mutext_grader'" in x.output for x in rep.questions), rep.text()
