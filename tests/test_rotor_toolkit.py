@@ -440,3 +440,21 @@ def test_sparse_modes_against_plain_rotor():
     two = cd.critical_speeds(order=2)[0]
     lam, _ = _plain_modes(rot, two.speed, 2)
     assert lam[1].imag == pytest.approx(2 * two.speed, rel=1e-8)
+
+
+def test_periodic_response_and_orbit_bad_input_is_named():
+    from mutext.rotor.periodic_orbit import periodic_unbalance_response
+    j = jeffcott(c=1.0)
+    with pytest.raises(ModelError, match="nothing loads"):
+        periodic_unbalance_response(j, 100.0, [1], weight=False)
+    with pytest.raises(ModelError, match="unbalance must be"):
+        periodic_unbalance_response(j, 100.0, [1], unbalance=(1,))
+    with pytest.raises(ModelError, match="harmonics"):
+        periodic_unbalance_response(j, 100.0, [1], harmonics=0)
+    with pytest.raises(ModelError, match="running speed"):
+        periodic_unbalance_response(j, -1.0, [1])
+    with pytest.raises(ModelError, match="mapping"):
+        orbit(5, 10.0)
+    # a model without ports: the weight alone sags the Jeffcott disk by m g / k
+    r = periodic_unbalance_response(j, 100.0, [1], harmonics=1)
+    assert r.Y[0, 0].real == pytest.approx(-2.0 * 9.80665 / 8.0e4, rel=1e-12)

@@ -36,6 +36,7 @@ Rotating Machines*, Cambridge University Press, 2010, sec. 3.5 and 3.6.
 """
 from __future__ import annotations
 
+from collections.abc import Mapping
 from dataclasses import dataclass
 
 import numpy as np
@@ -162,8 +163,10 @@ def orbit(harmonics, speed: float, *, points: int = 361, label: str = "") -> Orb
         raise ModelError(f"orbit: speed must be positive and finite (rad/s), got {speed!r}")
     if isinstance(points, bool) or not isinstance(points, (int, np.integer)) or points < 8:
         raise ModelError(f"orbit: points must be an integer >= 8, got {points!r}")
+    if not isinstance(harmonics, Mapping):
+        raise ModelError(f"orbit: harmonics must be a mapping order -> (X, Y), got {type(harmonics).__name__}")
     h = {}
-    for k, xy in dict(harmonics).items():
+    for k, xy in harmonics.items():
         if isinstance(k, bool) or not isinstance(k, (int, np.integer)) or k < 0:
             raise ModelError(f"orbit: harmonic orders are integers >= 0, got {k!r}")
         try:

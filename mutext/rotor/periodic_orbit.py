@@ -42,7 +42,7 @@ import numpy as np
 from ..errors import ModelError
 from ..lti import blas_single_thread
 from .orbits import Orbit, orbit
-from .periodic import periodic_rotor
+from .periodic import PeriodicRotor, periodic_rotor
 from .unbalance import _unbalances, parse_probes, unbalance_force
 
 __all__ = ["PeriodicResponse", "periodic_unbalance_response", "periodic_steady_state", "weight_force"]
@@ -58,6 +58,23 @@ def weight_force(model, M=None, gravity: float = GRAVITY) -> np.ndarray:
     e = np.zeros(model.ndof)
     e[[model.layout.dof(s, "v") for s in range(1, model.layout.n_nodes + 1)]] = 1.0
     return -gravity * (M @ e)
+
+
+def _periodic_matrices(model, speed, values) -> PeriodicRotor:
+    """The time-periodic matrices of ``model``; without ports only the matrices are needed, so a model that
+    declares no input or output gets placeholder ports (the harmonic balance here loads DOFs directly)."""
+    from .assembly import Rotor
+    if not isinstance(model, Rotor) or model.layout.kind != "rotor":
+        raise ModelError(f"{getattr(model, 'name', model)!r}: needs a Rotor with two bending planes (planes = 2)")
+    if model.input_names and model.output_names:
+        return periodic_rotor(model, inputs=model.input_names[:1], outputs=model.output_names[:1], speed=speed,
+                              values=values)
+    from .elements import InputPort, OutputPort
+    ported = Rotor(model.elements, planes=2, speed=model.speed, n_stations=model.n_stations,
+                   inputs=[InputPort("_F1", 1)], outputs=[OutputPort("_x1", 1)], damping=model.damping,
+                   name=model.name)
+    v = None if values is None else model.values(values)
+    return periodic_rotor(ported, speed=speed, values=v)
 
 
 def periodic_steady_state(pr, forces: dict, harmonics: int) -> np.ndarray:
@@ -158,7 +175,9 @@ def periodic_unbalance_response(model, speed: float, probes, *, unbalance=None, 
     if isinstance(harmonics, bool) or not isinstance(harmonics, (int, np.integer)) or harmonics < 1:
         raise ModelError(f"harmonics must be a positive integer, got {harmonics!r}")
     pr_probes = parse_probes(model, probes)
-    pr = periodic_rotor(model, speed=speed, values=values)
+    if not weight and unbalance is None:
+        raise ModelError(f"{model.name}: nothing loads the rotor (weight=False and no unbalance)")
+    pr = _periodic_matrices(model, speed, values)
     forces = {}
     if weight:
         forces[0] = weight_force(model, pr.M)
@@ -171,8 +190,6 @@ def periodic_unbalance_response(model, speed: float, probes, *, unbalance=None, 
                                  f"got {it!r}")
             ub += _unbalances(model, it[0], it[1], it[2] if len(it) == 3 else 0.0)
         forces[1] = unbalance_force(model, ub, speed)
-    if not forces:
-        raise ModelError(f"{model.name}: nothing loads the rotor (weight=False and no unbalance)")
     Q = periodic_steady_state(pr, forces, harmonics)
     N = int(harmonics)
     one = np.concatenate([Q[N:N + 1].real, 2.0 * Q[N + 1:]])       # one-sided: order 0 real, k >= 1 doubled
