@@ -455,6 +455,8 @@ def test_periodic_response_and_orbit_bad_input_is_named():
         periodic_unbalance_response(j, -1.0, [1])
     with pytest.raises(ModelError, match="mapping"):
         orbit(5, 10.0)
-    # a model without ports: the weight alone sags the Jeffcott disk by m g / k
-    r = periodic_unbalance_response(j, 100.0, [1], harmonics=1)
-    assert r.Y[0, 0].real == pytest.approx(-2.0 * 9.80665 / 8.0e4, rel=1e-12)
+    # a model without ports: the weight alone sags the overhung disk's tip by m g L^3 / (3 EI)
+    r = periodic_unbalance_response(overhung(), 100.0, [1], harmonics=1)
+    o = OVERHUNG
+    assert r.Y[0, 0].real == pytest.approx(-o["m"] * 9.80665 * o["L"] ** 3 / (3 * o["EI"]), rel=1e-12)
+    assert abs(r.X[0, 0]) < 1e-15 and np.all(np.abs(r.X[1:]) < 1e-15)
