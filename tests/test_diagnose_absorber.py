@@ -69,6 +69,7 @@ def test_a_hidden_absorber_is_found_sized_and_written(example, seed, tmp_path):
     assert rms < 0.3 * NOISE, rms
 
 
+@pytest.mark.slow
 def test_a_loss_shared_by_every_spring_is_found_as_a_distributed_change(tmp_path):
     """The generator's ``stiffness_loss`` (its K times 1 - d, every spring alike) is the run of all springs
     changed by -d: kind, run and size within three reported standard uncertainties, explained, and the
@@ -113,3 +114,19 @@ def test_a_grounded_spring_on_a_pedestal_is_found_sized_and_written(tmp_path):
     clean = data(meas_ch, f)
     errs = [np.abs(np.log(model_response(ext, frf) / h)) for frf, h in zip(measured, clean)]
     assert float(np.sqrt(np.mean(np.concatenate(errs) ** 2))) < 0.3 * NOISE
+
+
+@pytest.mark.slow
+def test_a_spring_to_ground_split_by_a_mass_is_an_absorber(tmp_path):
+    """The generator's wrong model "one more mass" with k3 (m3 to ground) split into 2 k3 - m_x - 2 k3: on the
+    model's DOFs exactly an absorber at m3 with m_a = m_x / 4, k_a = k3 and no damper (eliminate m_x)."""
+    case = make_case("three_mass", "out_of_library", "wrong_model_extra_mass", 1, NOISE, workdir=tmp_path)
+    assert case.key["details"]["split_spring"] == "k3"
+    d = diagnose(case.model_path, case.measured, validate=case.validate)
+    assert d.status == "explained", d.report()
+    assert [(f.kind, f.station) for f in d.effects] == [("absorber", 3)], d.report()
+    f = d.effects[0]
+    k3 = 386.0                                   # the shipped model's k3 [N/m]
+    for v, sd, t in zip(f.values[:2], f.stds[:2], (case.key["details"]["value"] / 4, k3)):
+        assert abs(v - t) <= 3 * sd, (v, sd, t)
+    assert f.values[2] <= 3 * f.stds[2] + 1e-3   # no damper
