@@ -7,10 +7,11 @@ dampers and masses added at its stations; :mod:`~mutext.diagnose.faults.crack`: 
 shaft element; :mod:`~mutext.diagnose.faults.absorber`: a tuned-mass absorber (an added degree of
 freedom, three parameters); :mod:`~mutext.diagnose.faults.pedestal`: a spring to ground set on a
 pedestal (mass and spring, two parameters); :mod:`~mutext.diagnose.faults.distributed`: one relative
-stiffness change shared by a run of consecutive springs; :mod:`~mutext.diagnose.faults.channel`: effects on the measurement chain (a
-sensor's or an exciter's gain, a channel's scale or polarity -- unit slips --, a sensor's delay, a mass
-that moves with the sensor); :mod:`~mutext.diagnose.faults.structure`: changes of the whole structure
-(all damping scaled) or of the analyser's frequency axis.  :mod:`mutext.diagnose._hypotheses`
+stiffness change shared by a run of consecutive springs; :mod:`~mutext.diagnose.faults.channel`:
+effects on the measurement chain (a sensor's or an exciter's gain, a channel's scale or polarity --
+unit slips --, a sensor's delay, a mass that moves with the sensor);
+:mod:`~mutext.diagnose.faults.structure`: changes of the whole structure (all damping scaled) or of the
+analyser's frequency axis.  :mod:`mutext.diagnose._hypotheses`
 assembles them.
 """
 from . import absorber, channel, crack, distributed, lumped, pedestal, rotor, structure

@@ -18,7 +18,8 @@ one solve per frequency.  Cheap for lumped chains; for a 120-DOF rotor about
 
 A damping scale is written into the model file by scaling every damping value
 it holds (dampers, bearings' damping, the ``[damping]`` table;
-:class:`mutext.rotor.model_writer.ModelFile`); a frequency scale is a correction of the measurement and leaves the model unchanged.
+:class:`mutext.rotor.model_writer.ModelFile`); a frequency scale is a
+correction of the measurement and leaves the model unchanged.
 """
 from __future__ import annotations
 
