@@ -180,6 +180,17 @@ def _version() -> str:
 
 
 def main(argv=None) -> int:
+    try:
+        return _main(argv)
+    except BrokenPipeError:
+        # output piped into e.g. `head`, which closed early (the help, a report): not an error of ours;
+        # stdout goes to /dev/null so the interpreter's final flush does not raise again
+        import os
+        os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
+        return 0
+
+
+def _main(argv=None) -> int:
     argv = sys.argv[1:] if argv is None else list(argv)
     if argv[:1] in (["--version"], ["-V"]):
         print(f"mutext {_version()}")
@@ -219,11 +230,6 @@ def main(argv=None) -> int:
     except MutextError as exc:
         print(f"mutext {cmd}: error: {exc}", file=sys.stderr)
         return 1
-    except BrokenPipeError:
-        # output piped into e.g. `head`, which closed early: not an error of ours
-        import os
-        os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
-        return 0
     print(f"mutext: unknown command '{cmd}' (expected one of diagnose, rig, frf, rotor, demo, check, grade)", file=sys.stderr)
     return 2
 

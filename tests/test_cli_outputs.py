@@ -97,3 +97,16 @@ def test_a_usage_error_is_said_before_the_heavy_imports():
             "print(rc, 'numpy' in sys.modules, 'casadi' in sys.modules)")
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=120)
     assert out.stdout.split() == ["2", "False", "False"], out
+
+
+@pytest.mark.parametrize("args", [["--help"], ["--version"], ["help"]])
+def test_output_piped_into_a_reader_that_stops_is_no_traceback(args):
+    # `mutext --help | head -1`: the reader closes the pipe before mutext writes
+    import subprocess
+    import sys
+    p = subprocess.Popen([sys.executable, "-c", "import sys; from mutext.cli import main; sys.exit(main())", *args],
+                         stdout=subprocess.PIPE, stderr=subprocess.PIPE)
+    p.stdout.close()
+    err = p.stderr.read().decode()
+    assert p.wait() == 0
+    assert "Traceback" not in err and "BrokenPipe" not in err
