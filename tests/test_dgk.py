@@ -48,6 +48,9 @@ def test_dgk_reported_bound_is_the_ab13md_bound(two_mass_dgk):
     value of a flat stretch of the bound (the D-G bound has to be evaluated there too)."""
     res, CL, ref, _, _ = two_mass_dgk
     assert res.mu_upper_dg == pytest.approx(ref.max(), rel=1e-4)
+    # the loop kept is the iteration with the lowest D-G bound (not the lowest complex one)
+    dg = {h["iteration"]: h["mu_dg"] for h in res.history}
+    assert dg[res.best_iteration] == min(dg.values())
     # the real lower bound, taken where the D-G bound peaks (the complex bound peaks
     # elsewhere), meets it: a real perturbation of that size destabilises the loop
     assert res.mu_upper_dg * (1 - 1e-4) <= res.mu_lower <= res.mu_upper_dg * (1 + 1e-9)

@@ -100,7 +100,14 @@ def test_diagnose_reports_sidebands_for_data_taken_at_speed():
     page = _html(res, [])
     assert "<h2>At speed</h2>" in page and "once per revolution" in page
     assert "crack turning with the shaft" in page
-    # a bearing change at speed: no sidebands
+
+
+@pytest.mark.slow
+def test_diagnose_reports_no_sidebands_for_a_bearing_change_at_speed():
+    # covered in the default run by test_time_invariant_changes_show_none (a bearing change at speed
+    # shows no sidebands) and test_diagnose_reports_sidebands_for_data_taken_at_speed (diagnose
+    # reports the sideband verdict)
+    from mutext.diagnose import diagnose
     bear = rotor(text=TEXT.replace("stiffness = 1.0e7", "stiffness = 0.8e7", 1))
     res = diagnose(data_path("rotor.toml"), [sweep(bear, seed=6, noise=1e-3)], refit=1,
                    only=lambda h: h.kind in ("crack", "bearing", "stiffness") and h.station in (2, 15))
