@@ -161,8 +161,8 @@ def test_bracket_ends_and_constants_score_nothing():
 def test_c_window_is_above_the_floor_for_every_draw():
     """The bracket of (c) never puts an end or a mean of it in the accepted window (floor to 1.15 times the
     reference, which is at most 1.1 times the floor times 1.3 from the secant steps)."""
-    for seed in range(6):
-        rng = np.random.default_rng(seed)
+    rng = np.random.default_rng(0)
+    for _ in range(2000):
         fl = 1.0
         lo, hi = ex08._bracket(rng, fl)
         assert lo < 0.95 * fl

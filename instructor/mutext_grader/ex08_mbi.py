@@ -274,7 +274,8 @@ def draw_rig(rng):
 
 def _bracket(rng, fl):
     lo = fl * rng.uniform(0.5, 0.9)
-    hi = fl * rng.uniform(max(3.0, 2.6 / (lo / fl)), 5.0)
+    a = max(3.0, 2.6 / (lo / fl))                   # sqrt(lo hi) at least 1.6 times the floor
+    hi = fl * rng.uniform(a, a + 2.0)
     return float(f"{lo:.4g}"), float(f"{hi:.4g}")
 
 
