@@ -110,7 +110,8 @@ def closed_loop_figure(CL, omega=None, P=None, input_names=None, output_names=No
     omega = np.asarray(omega, float)
     input_names = input_names or list(CL.input_labels)
     output_names = output_names or list(CL.output_labels)
-    fig, axes = plt.subplots(nz, nw, figsize=(4.2 * nw, 2.8 * nz), sharex=True, squeeze=False)
+    # at most 7 in wide: the book's text column, so the text is not scaled down
+    fig, axes = plt.subplots(nz, nw, figsize=(min(4.2 * nw, 7.0), 2.8 * nz), sharex=True, squeeze=False)
     G = freqresp(CL, omega)
     G0 = None
     if P is not None:
@@ -267,7 +268,7 @@ def mbi_figure(result, true_systems, Du=None, title=None):
     pr = result.plant.ports
     E = result.plant.engineering
     ie, oe = list(E.input_labels).index(pr["excitation"]), list(E.output_labels).index(pr["measurement"])
-    fig, ax = plt.subplots(2, 2, figsize=(10, 7))
+    fig, ax = plt.subplots(2, 2, figsize=(7, 5.6))   # the book's text column
     a = ax[0, 0]
     for k, T in enumerate(true_systems):
         T = as_ss(T)
