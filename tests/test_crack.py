@@ -564,3 +564,82 @@ def test_crack_element_errors():
         cr.Crack(3, 0.2, orientation="vertical")
     with pytest.raises(ModelError, match="solid shaft"):
         Rotor(_shafts(di=0.005) + [cr.Crack(3, 0.2)], planes=1)
+
+
+# ----------------------------------------------------------------------------
+# gaping notch or breathing crack, from the slot width (breathing = "auto")
+# ----------------------------------------------------------------------------
+
+def _auto_rotor(extra):
+    from mutext.rotor import data_path, loads_model
+    text = open(data_path("rotor.toml")).read() + "[[crack]]\nstation = 15\ndepth_ratio = 0.4\n" + extra
+    return loads_model(text, base_dir=data_path(""))
+
+
+def _hand_moment_at_15(table):
+    """Weight moment at station 15 of the shaft simply supported at stations 2 and 29, by statics
+    on the station table (each element's mass split between its ends, plus the added masses)."""
+    z = np.concatenate([[0.0], np.cumsum([s.length for s in table.stations])])[:len(table.stations)]
+    m = np.array([s.added_mass for s in table.stations], float)
+    for i, s in enumerate(table.stations[:-1]):
+        me = s.density * np.pi / 4 * (s.outer_diameter ** 2 - s.inner_diameter ** 2) * s.length
+        m[i] += me / 2
+        m[i + 1] += me / 2
+    W = 9.80665 * m
+    za, zb = z[1], z[28]                        # stations 2 and 29
+    Rb = np.sum(W * (z - za)) / (zb - za)       # moments about the left bearing
+    Ra = W.sum() - Rb
+    zc = z[14]                                  # station 15
+    left = z < zc
+    return Ra * (zc - za) - np.sum(W[left] * (zc - z[left]))
+
+
+def test_auto_breathing_thesis_slot_is_gaping_with_micrometre_faces():
+    r = _auto_rotor("breathing = 'auto'\nslot_width = 115e-6\n")
+    ch = r.breathing_choices["crack15"]
+    cr_el = next(e for e in r.elements if e.name == "crack15")
+    assert ch.law == "gaping" and cr_el.breathing == "gaping" and cr_el.breathing_choice is ch
+    assert "never touch" in ch.reason
+    # hand beam formula: M c / (E I) times a gauge length of one diameter (the crack's local
+    # flexibility spreads over about a diameter: l_eq = E I c55 is 0.3-1 D for a/D = 0.4)
+    st = r.table.stations[14]
+    D, E = st.outer_diameter, st.youngs_modulus
+    I = np.pi * D ** 4 / 64
+    M_hand = _hand_moment_at_15(r.table)
+    assert abs(ch.moment) == pytest.approx(abs(M_hand), rel=0.03)     # statically determinate shaft
+    delta_hand = abs(M_hand) * (D / 2) / (E * I) * D
+    assert 0.3e-6 < ch.face_displacement < 3e-6
+    assert 1 / 3 < ch.face_displacement / delta_hand < 3
+    assert ch.face_displacement < 115e-6 / 30
+
+
+def test_auto_breathing_fatigue_crack_breathes():
+    r = _auto_rotor("breathing = 'auto'\nslot_width = 0\nclosing_law = 'gasch'\n")
+    assert r.breathing_choices["crack15"].law == "gasch"
+    r = _auto_rotor("breathing = 'auto'\nslot_width = 0.0\n")
+    assert r.breathing_choices["crack15"].law == "mayes"
+    assert next(e for e in r.elements if e.name == "crack15").breathing == "mayes"
+
+
+@pytest.mark.parametrize("extra, words", [
+    ("breathing = 'auto'\n", "needs slot_width"),
+    ("breathing = 'auto'\nslot_width = -1e-6\n", "slot_width"),
+    ("breathing = 'auto'\nslot_width = 'wide'\n", "slot_width"),
+    ("breathing = 'mayes'\nslot_width = 1e-4\n", "only with breathing = 'auto'"),
+    ("breathing = 'auto'\nslot_width = 0\nclosing_law = 'gaping'\n", "closing_law"),
+])
+def test_auto_breathing_named_errors(extra, words):
+    with pytest.raises(ModelError) as exc:
+        _auto_rotor(extra)
+    assert "[[crack]] #1" in str(exc.value) and words in str(exc.value)
+
+
+def test_gaping_names():
+    assert cr.breathing_law("open") == cr.breathing_law("notch") == cr.breathing_law("gaping") == "gaping"
+    assert np.array_equal(cr.breathing_fourier("open", 3), cr.breathing_fourier("gaping", 3))
+    # the gaping notch varies at 0 and 2x only
+    c = cr.breathing_fourier("gaping", 4)
+    assert np.all(np.abs(c[[4 - 4, 4 - 3, 4 - 1, 4 + 1, 4 + 3, 4 + 4]]) < 1e-14)
+    assert np.max(np.abs(c[4 + 2])) > 0.1
+    with pytest.raises(ModelError, match="breathing law"):
+        cr.breathing_law("ajar")

@@ -120,7 +120,8 @@ __all__ = [
     "equivalent_reduced_inertia",
     "open_fraction", "rotating_frame_stiffness", "fixed_frame_stiffness",
     "Crack",
-    "BREATHING_LAWS", "breathing_weights", "breathing_fourier",
+    "BREATHING_LAWS", "BREATHING_ALIASES", "breathing_law", "breathing_weights", "breathing_fourier",
+    "BreathingChoice", "face_displacement", "choose_breathing",
 ]
 
 #: Largest depth ratio a/D for which the strip integration is used ([Pap04]_).
@@ -629,7 +630,7 @@ def equivalent_reduced_inertia(I, E, compliance, length):
 # breathing crack
 # ----------------------------------------------------------------------------
 
-_MODELS = ("mayes", "gasch", "open", "closed")
+_MODELS = ("mayes", "gasch", "gaping", "open", "notch", "closed")
 
 
 def open_fraction(psi, model: str = "mayes"):
@@ -646,7 +647,8 @@ def open_fraction(psi, model: str = "mayes"):
     * ``"gasch"`` (switching hinge, Gasch [Ga93]_): :math:`f = 1` for
       :math:`\cos\psi \ge 0` (open during the half turn in which the crack
       is in tension), :math:`f = 0` otherwise.
-    * ``"open"``: :math:`f = 1` (always open: an asymmetric shaft).
+    * ``"gaping"`` (aliases ``"open"``, ``"notch"``): :math:`f = 1` (always
+      open: a notch whose faces never touch, an asymmetric shaft).
     * ``"closed"``: :math:`f = 0` (healthy).
 
     Works on floats, numpy arrays and CasADi expressions.
@@ -659,7 +661,7 @@ def open_fraction(psi, model: str = "mayes"):
         return 0.5 * (1.0 + cos(psi))
     if model == "gasch":
         return ca.if_else(cos(psi) >= 0, 1.0, 0.0) if sym else np.where(np.cos(psi) >= 0, 1.0, 0.0)
-    one = 1.0 if model == "open" else 0.0
+    one = 0.0 if model == "closed" else 1.0
     return one + 0.0 * psi
 
 
@@ -713,8 +715,24 @@ def fixed_frame_stiffness(k0, dk_xi, dk_eta, theta, psi, model: str = "mayes"):
                      [-f * d * s2, k0 - f * (s - d * c2)]])
 
 
-#: Breathing laws a crack in a model file may declare (``breathing = ...``).
-BREATHING_LAWS = ("open", "mayes", "gasch")
+#: Breathing laws a crack in a model file may declare (``breathing = ...``).  ``"gaping"``: a
+#: notch whose faces never touch (a wire-EDM slot wider than the faces move), always open and
+#: turning with the shaft, so its stiffness varies at twice the running speed only; ``"mayes"``
+#: and ``"gasch"``: a crack that opens and closes under the shaft's weight (once per revolution).
+BREATHING_LAWS = ("gaping", "mayes", "gasch")
+
+#: Other names accepted for a law: ``"open"`` (the name used before ``"gaping"``) and ``"notch"``.
+BREATHING_ALIASES = {"open": "gaping", "notch": "gaping"}
+
+
+def breathing_law(name) -> str:
+    """The documented name of breathing law ``name`` (an alias resolved), or a :class:`ModelError`."""
+    if isinstance(name, str):
+        name = BREATHING_ALIASES.get(name, name)
+        if name in BREATHING_LAWS:
+            return name
+    raise ModelError(f"breathing law must be one of {', '.join(BREATHING_LAWS)} (or the aliases "
+                     f"{', '.join(BREATHING_ALIASES)}), got {name!r}")
 
 
 def breathing_weights(theta, law: str):
@@ -735,8 +753,7 @@ def breathing_weights(theta, law: str):
     Returns the three weights :math:`f\cos^2\theta`, :math:`f\sin^2\theta`,
     :math:`f\sin\theta\cos\theta` (arrays shaped like ``theta``).
     """
-    if law not in BREATHING_LAWS:
-        raise ModelError(f"breathing law must be one of {BREATHING_LAWS}, got {law!r}")
+    law = breathing_law(law)
     th = np.asarray(theta, dtype=float)
     f = open_fraction(th + np.pi / 2.0, law)
     c, s = np.cos(th), np.sin(th)
@@ -754,8 +771,7 @@ def breathing_fourier(law: str, n_terms: int = 16, *, samples: int = 4096) -> np
     :math:`\theta = 0, \pi` and its coefficients decay like :math:`1/m`
     (trapezoidal rule with the jumps on samples: error :math:`O(\text{samples}^{-2})`).
     """
-    if law not in BREATHING_LAWS:
-        raise ModelError(f"breathing law must be one of {BREATHING_LAWS}, got {law!r}")
+    law = breathing_law(law)
     if isinstance(n_terms, bool) or not isinstance(n_terms, (int, np.integer)) or n_terms < 0:
         raise ModelError(f"n_terms must be a non-negative integer, got {n_terms!r}")
     samples = max(int(samples), 4 * n_terms + 8)
@@ -769,6 +785,170 @@ def breathing_fourier(law: str, n_terms: int = 16, *, samples: int = 4096) -> np
     F = np.fft.fft(g, axis=0) / samples
     m = np.arange(-n_terms, n_terms + 1)
     return F[m % samples]
+
+
+# ----------------------------------------------------------------------------
+# gaping notch or breathing crack: the faces' movement under the shaft's weight
+# ----------------------------------------------------------------------------
+
+#: Standard gravity [m/s^2].
+STANDARD_GRAVITY = 9.80665
+
+
+def face_displacement(moment, compliance, depth):
+    r"""Relative displacement of the crack faces at the mouth under a bending moment [m].
+
+    The open crack adds the rotation jump :math:`\Delta\varphi = c_{55} M`
+    between its faces ([DP83]_; :func:`crack_compliance`): the hinge model
+    of [Ga93]_, in which the two faces turn about the crack front.  The mouth
+    lies at the depth :math:`a` from the front, so the faces there move
+    apart (moment opening the crack) or together (closing it) by
+
+    .. math::
+        \delta = a\,\Delta\varphi = a\,c_{55}\,|M|.
+
+    This is the crack-mouth opening of the edge-cracked strip in bending
+    expressed through the compliance ([TPI]_: the CMOD and the compliance
+    both follow from the same stress-intensity factor); it counts the
+    crack's own flexibility only, not the strain of the intact material
+    over the slot width (smaller by the factor :math:`w/\ell_{eq}`, with
+    :math:`\ell_{eq} = E I c_{55}` the crack's equivalent length).
+
+    Parameters
+    ----------
+    moment : float
+        Bending moment at the crack [N m] (sign ignored).
+    compliance : float
+        :math:`c_{55}` [rad/(N m)].
+    depth : float
+        Crack depth :math:`a` [m].
+    """
+    M = _scalar(moment, "moment")
+    c = _scalar(compliance, "compliance")
+    a = _scalar(depth, "depth")
+    if c < 0 or a < 0:
+        raise ModelError(f"compliance and depth must be non-negative, got {c!r} and {a!r}")
+    return abs(M) * c * a
+
+
+class BreathingChoice:
+    """Which crack law a slot of given width follows, and why (:func:`choose_breathing`).
+
+    Attributes
+    ----------
+    law : str
+        ``"gaping"`` or the closing law.
+    slot_width : float
+        Gap between the faces at rest [m] (0: a fatigue crack).
+    face_displacement : float
+        Movement of the faces at the mouth under the shaft's weight [m].
+    moment : float
+        Static bending moment at the crack [N m].
+    reason : str
+    """
+
+    def __init__(self, law, slot_width, face_displacement, moment, reason):
+        self.law, self.slot_width, self.face_displacement = law, float(slot_width), float(face_displacement)
+        self.moment, self.reason = float(moment), reason
+
+    def __repr__(self):
+        return f"BreathingChoice({self.law!r}: {self.reason})"
+
+    def to_dict(self) -> dict:
+        return {"law": self.law, "slot_width": self.slot_width, "face_displacement": self.face_displacement,
+                "moment": self.moment, "reason": self.reason}
+
+
+def _slot_width(slot_width, name="slot_width") -> float:
+    if isinstance(slot_width, bool) or not isinstance(slot_width, (int, float, np.integer, np.floating)):
+        raise ModelError(f"{name} must be a number [m] (the gap between the crack faces at rest; 0 for a "
+                         f"fatigue crack), got {slot_width!r}")
+    w = float(slot_width)
+    if not np.isfinite(w) or w < 0:
+        raise ModelError(f"{name} must be finite and >= 0 [m] (the gap between the crack faces at rest), "
+                         f"got {w!r}")
+    return w
+
+
+def choose_breathing(rotor, station: int, depth_ratio: float, slot_width: float, *, xi: float = 0.0,
+                     closing_law: str = "mayes", gravity: float = STANDARD_GRAVITY,
+                     name: str = "crack") -> BreathingChoice:
+    r"""Gaping notch or breathing crack, from the slot width and the static deflection.
+
+    The shaft's own weight bends it: the static solution :math:`K q = -g M
+    e_y` (:math:`y` up, gravity on every mass of ``rotor``, which should
+    not hold the crack itself) gives the host element's end forces
+    :math:`f = K_e q_e` in the y-z plane and from them the bending moment at
+    the crack, :math:`M(\xi L) = -f_2 + f_1\,\xi L` (the moment carried
+    across the section at :math:`\xi L`).  Turning with the shaft the crack
+    passes the tension and the compression side once per revolution, and its
+    faces move by :math:`\pm\delta` about their rest gap,
+    :math:`\delta = a\,c_{55}\,|M|` (:func:`face_displacement`).  When
+    :math:`\delta` is smaller than the slot width :math:`w` the faces never
+    touch: the crack is a **gaping** notch (stiffness varying at 2x only).
+    Otherwise (a fatigue crack, :math:`w = 0`) it closes on the compression
+    side and breathes by ``closing_law`` (Mayes by default).
+
+    Parameters
+    ----------
+    rotor : Rotor
+        The rotor whose weight loads the crack (bearings included, the crack
+        left out: its influence on the moment of a statically determinate
+        two-bearing shaft is nil).
+    station, xi : int, float
+        Host element and position of the crack in it.
+    depth_ratio : float
+        :math:`a/D`.
+    slot_width : float
+        :math:`w` [m], the gap between the faces at rest (0: a fatigue crack).
+    closing_law : {"mayes", "gasch"}
+    gravity : float
+        [m/s^2].
+
+    Returns
+    -------
+    BreathingChoice
+    """
+    w = _slot_width(slot_width, f"{name}: slot_width")
+    closing_law = breathing_law(closing_law)
+    if closing_law == "gaping":
+        raise ModelError(f"{name}: closing_law must be 'mayes' or 'gasch' (the law of a crack whose faces "
+                         f"touch), got {closing_law!r}")
+    from .shaft_element import T_YZ
+    v = rotor.values()
+    Mm, _, K, _ = rotor.matrices(v)
+    load = np.zeros(rotor.ndof)
+    ydofs = [i for i, n in enumerate(rotor.dof_names) if n.startswith("v")]
+    load[ydofs] = -gravity
+    F = Mm @ load
+    try:
+        q = np.linalg.solve(K, F)
+    except np.linalg.LinAlgError:
+        raise ModelError(f"{name}: the rotor's static deflection under its weight has no solution (is it "
+                         f"supported? the stiffness matrix is singular)") from None
+    host = rotor.shaft_element(station)
+    psym = rotor._ps.symbols
+    Kp = np.asarray(ca.Function("Ke", [rotor.p], [host.plane_matrices(psym)[2]])(v).full())
+    Lh = float(host.nominal("L"))
+    qe = np.asarray(T_YZ.full() if hasattr(T_YZ, "full") else T_YZ) @ q[host.dofs(rotor.layout)]
+    f = Kp @ qe
+    moment = float(-f[1] + f[0] * xi * Lh)
+    D = float(host.nominal("do"))
+    E = float(host.nominal("E"))
+    nu = float(host.nominal("nu")) if host.has("nu") else E / (2.0 * float(host.nominal("G"))) - 1.0
+    c55 = float(crack_compliance(float(depth_ratio), E, D, nu))
+    delta = face_displacement(moment, c55, depth_ratio * D)
+    if delta < w:
+        law = "gaping"
+        reason = (f"the faces move {delta * 1e6:.3g} um under the shaft's weight (M = {moment:.3g} N m at "
+                  f"the crack), less than the slot width {w * 1e6:.3g} um: they never touch, a gaping notch "
+                  f"(stiffness varying at 2x only)")
+    else:
+        law = closing_law
+        reason = (f"the faces move {delta * 1e6:.3g} um under the shaft's weight (M = {moment:.3g} N m at "
+                  f"the crack), at least the slot width {w * 1e6:.3g} um: they close on the compression side, "
+                  f"a breathing crack ({closing_law} law)")
+    return BreathingChoice(law, w, delta, moment, reason)
 
 
 # ----------------------------------------------------------------------------
@@ -835,7 +1015,7 @@ def _make_crack_class():
             stiffness loss and over-estimates the asymmetry of a deep crack
             (:math:`c_{44}/c_{55} \approx 0.42` at a/D = 0.4: mean loss x1.44,
             asymmetry x0.56 for the thesis rotor's crack with ``True``).
-        breathing : {None, "open", "mayes", "gasch"}
+        breathing : {None, "gaping", "mayes", "gasch"}
             A crack that turns with the shaft (see :mod:`mutext.rotor.periodic`):
             ``orientation`` is then the angle of the crack normal from :math:`x`
             at :math:`t = 0`, the rotor is linear time-periodic at speed, and
@@ -843,7 +1023,11 @@ def _make_crack_class():
             holds the stiffness averaged over one revolution (the
             :math:`m = 0` term of :func:`breathing_fourier`: :math:`(A_{xx} +
             A_{yy})/4` for ``"mayes"`` and ``"gasch"``, :math:`/2` for
-            ``"open"``).  Needs two bending planes.
+            ``"gaping"``, the always-open notch; ``"open"`` and ``"notch"``
+            are accepted for it).  Needs two bending planes.  A model file's
+            ``breathing = "auto"`` chooses between them from the slot width
+            (:func:`choose_breathing`); the choice is kept in
+            ``breathing_choice`` (else ``None``).
         name : str, optional
             Default ``"crack<station>"``.
 
@@ -859,13 +1043,16 @@ def _make_crack_class():
                      n_quad: int = 16, perpendicular: bool = False, breathing: str | None = None,
                      name: str | None = None):
             Element.__init__(self, (station, station + 1), name, depth_ratio=depth_ratio)
-            if breathing is not None and breathing not in BREATHING_LAWS:
-                raise ModelError(f"{self.name}: breathing must be one of {', '.join(BREATHING_LAWS)}, "
-                                 f"got {breathing!r}")
+            if breathing is not None:
+                try:
+                    breathing = breathing_law(breathing)
+                except ModelError as exc:
+                    raise ModelError(f"{self.name}: {exc}") from None
             if breathing is not None and orientation == "mean":
                 raise ModelError(f"{self.name}: a breathing crack turns with the shaft; give its angle "
                                  "at t = 0 as orientation [rad], not 'mean'")
             self.breathing = breathing
+            self.breathing_choice = None
             d = self.nominal("depth_ratio")
             if not 0.0 <= d <= MAX_DEPTH_RATIO:
                 raise ModelError(f"{self.name}.depth_ratio must lie in [0, {MAX_DEPTH_RATIO}] "

@@ -66,10 +66,16 @@ Rotor files
     [[crack]]                     # needs mutext.rotor.crack
     station = 15
     depth_ratio = 0.4
-    breathing = "mayes"           # optional ("open", "mayes", "gasch"): turns with the shaft and
-                                  # breathes under weight; orientation = its angle at t = 0 [rad].
-                                  # Time-invariant analyses use its revolution average; the
-                                  # time-periodic rotor is mutext.rotor.periodic
+    breathing = "mayes"           # optional: the crack turns with the shaft; orientation = its angle
+                                  # at t = 0 [rad].  "gaping" (also "open", "notch"): always open,
+                                  # stiffness varying at 2x only (a slot whose faces never touch);
+                                  # "mayes", "gasch": opens and closes under weight (1x, 2x, 3x ...);
+                                  # "auto": chosen from slot_width [m] (gap between the faces at rest,
+                                  # 0 for a fatigue crack) against the faces' movement under the
+                                  # rotor's weight (mutext.rotor.crack.choose_breathing; closing_law =
+                                  # "mayes" (default) or "gasch" when they touch).  The choice and why:
+                                  # rotor.breathing_choices[name].  Time-invariant analyses use the
+                                  # revolution average; the time-periodic rotor is mutext.rotor.periodic
 
 Lumped chains
 -------------
@@ -440,6 +446,7 @@ def _load_rotor(ctx: _Ctx, doc: dict, base_dir: str, station_table=None) -> Roto
         s = ctx.station(t, where, n)
         d = _direction(ctx, t, where, planes)
         outs.append(OutputPort(ctx.string(t, "name", where) or ("y" if d == "v" else "x") + str(s), s, d))
+    auto = []
     for k, t in enumerate(_array_of_tables(ctx, doc, "crack"), start=1):
         where = f"[[crack]] #{k}"
         if not isinstance(t, dict):
@@ -447,17 +454,45 @@ def _load_rotor(ctx: _Ctx, doc: dict, base_dir: str, station_table=None) -> Roto
         if "depth_ratio" not in t:
             raise ctx.err(where, "missing 'depth_ratio'")
         s = ctx.station(t, where, n - 1)
-        extra.append(_make_crack(ctx, t, where, s))
+        t = _auto_keys(ctx, t, where)
+        if t.get("breathing") == "auto":
+            auto.append((len(extra), t, where, s))
+        # an "auto" crack is checked as a Mayes crack now and built with its law below
+        extra.append(_make_crack(ctx, {kk: ("mayes" if kk == "breathing" and vv == "auto" else vv)
+                                       for kk, vv in t.items() if kk not in _AUTO_KEYS}, where, s))
     damping = _damping(ctx, doc.get("damping"))
     if isinstance(damping, StructuralDamping):          # an element: it knows which elements are members
         extra.append(damping)
         damping = None
-    try:
-        rotor = rotor_from_table(table, poisson_ratio=nu, shear_modulus=G, ports_from_flags=ports,
-                                 extra_elements=extra, inputs=ins, outputs=outs, planes=planes, speed=speed,
-                                 damping=damping, name=str(doc.get("name", os.path.basename(ctx.source))))
-    except ModelError as exc:
-        raise ModelError(f"{ctx.source}: {exc}") from None
+
+    def build(elements):
+        try:
+            return rotor_from_table(table, poisson_ratio=nu, shear_modulus=G, ports_from_flags=ports,
+                                    extra_elements=elements, inputs=ins, outputs=outs, planes=planes, speed=speed,
+                                    damping=damping, name=str(doc.get("name", os.path.basename(ctx.source))))
+        except ModelError as exc:
+            raise ModelError(f"{ctx.source}: {exc}") from None
+
+    choices = {}
+    if auto:
+        # the weight's moment at each "auto" crack, on the rotor without those cracks
+        skip = {i for i, *_ in auto}
+        plain = build([e for i, e in enumerate(extra) if i not in skip])
+        from .crack import choose_breathing
+        for i, t, where, s in auto:
+            try:
+                ch = choose_breathing(plain, s, float(t["depth_ratio"]), t["slot_width"],
+                                      xi=float(t.get("xi", 0.0)), closing_law=t.get("closing_law", "mayes"),
+                                      name=f"{ctx.source} {where}")
+            except ModelError as exc:
+                raise ctx.err(where, str(exc).replace(f"{ctx.source} {where}: ", "")) from None
+            tt = {kk: vv for kk, vv in t.items() if kk not in _AUTO_KEYS}
+            tt["breathing"] = ch.law
+            extra[i] = _make_crack(ctx, tt, where, s)
+            extra[i].breathing_choice = ch
+            choices[extra[i].name] = ch
+    rotor = build(extra)
+    rotor.breathing_choices = choices
     rotor.table = table
     rotor.source = ctx.source
     rotor.units = ctx.system
@@ -472,6 +507,28 @@ def _direction(ctx, t, where, planes):
     if d == "y" and planes == 1:
         raise ctx.err(f"{where}, direction", "'y' needs planes = 2")
     return table[d]
+
+
+_AUTO_KEYS = ("slot_width", "closing_law")
+
+
+def _auto_keys(ctx, t, where):
+    """Check the keys of ``breathing = "auto"`` (slot_width, closing_law); the table unchanged."""
+    b = t.get("breathing")
+    if b == "auto":
+        if "slot_width" not in t:
+            raise ctx.err(where, "breathing = 'auto' needs slot_width [m] (the gap between the crack faces "
+                          "at rest; 0 for a fatigue crack)")
+        t = dict(t, slot_width=ctx.number(t, "slot_width", "length", where))
+        law = t.get("closing_law", "mayes")
+        if law not in ("mayes", "gasch"):
+            raise ctx.err(f"{where}, closing_law", f"must be 'mayes' or 'gasch' (the law when the faces "
+                          f"touch), got {law!r}")
+    else:
+        for key in _AUTO_KEYS:
+            if key in t:
+                raise ctx.err(f"{where}, {key}", "only with breathing = 'auto'")
+    return t
 
 
 def _make_crack(ctx, t, where, station):
