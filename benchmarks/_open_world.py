@@ -920,10 +920,10 @@ def claimed_data(chain: Chain, effects):
         if kind in ("stiffness", "damping"):
             mat, els = ("K", chain.springs) if kind == "stiffness" else ("C", chain.dampers)
             el = next((x for x in els if x["name"] == element), None)
+            P = np.zeros(st.M.shape)    # (with the DOFs other effects added after the chain's)
             if el is not None:
-                P = chain.pattern(el["between"])
+                P[:n, :n] = chain.pattern(el["between"])
             else:                       # an added grounded element at the mass ``station``
-                P = np.zeros((n, n))
                 P[int(station) - 1, int(station) - 1] = 1.0
             st = replace(st, **{mat: getattr(st, mat) + v * P})
         elif kind == "mass":
@@ -944,7 +944,9 @@ def claimed_data(chain: Chain, effects):
             fo, se = str(element).split("->")
             st = replace(st, scale={**st.scale, (fo, se): st.scale.get((fo, se), 1.0) * v})
         elif kind == "damping_scale":
-            st = replace(st, C=st.C + v * C)
+            Cx = st.C.copy()
+            Cx[:n, :n] += v * C
+            st = replace(st, C=Cx)
         elif kind == "frequency_scale":
             st = replace(st, eps=st.eps + v)
         elif kind == "sensor_mass":

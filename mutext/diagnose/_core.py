@@ -529,7 +529,54 @@ def _select_more(effects, hyps, rec, fit, held, s2, N, threshold, alpha, ref, no
             new.append(f)
         effects, thetas = new, list(th)
         quality = quality_of(effects, thetas)
+    if len(effects) > 1:
+        simpler = _simplify(effects, hyps, rec, fit, s2, N, threshold, notes)
+        if simpler is not effects:
+            effects = simpler
+            quality = quality_of(effects, [e.theta for e in effects])
     return effects, quality
+
+
+def _simplify(effects, hyps, rec, fit, s2, N, threshold, notes):
+    """Effects with a k-parameter one replaced by its nested one-parameter reading (``Hypothesis.nested``) when,
+    fitted jointly with the others, the simpler reading is not worse by more than the chi2_(k-1) threshold
+    (a pedestal whose mass the joint fit leaves at zero is a softer spring).  Returns ``effects`` itself when
+    nothing is replaced."""
+    n_par = sum(e.hypothesis.n_params for e in effects)
+    full = _rss_of(Compound(rec, fit, [e.hypothesis for e in effects]).responses([e.theta for e in effects]),
+                   fit.meas)
+    left = max(1.0, full / (s2 * max(N - n_par, 1)))
+    for k, e in enumerate(effects):
+        h = e.hypothesis
+        if not h.params or not h.nested:
+            continue
+        others = [x for j, x in enumerate(effects) if j != k]
+        base, th = [x.hypothesis for x in others], [x.theta for x in others]
+        for key in h.nested:
+            g = next((x for x in hyps if (x.kind, x.element) == key), None)
+            if g is None:
+                continue
+            t, _ = fit_one_given(rec, fit, base, th, g)
+            th2, rss2, sd2 = joint_fit(rec, fit, base + [g], th + [t], s2)
+            if (rss2 - full) / s2 / left >= threshold_k(threshold, h.n_params - 1):
+                continue
+            notes.append(f"{h.description} reads as {g.description} given the other effects (its "
+                         f"{h.n_params - 1} further parameter(s) improve the fit by delta chi2 "
+                         f"{(rss2 - full) / s2:.1f} only): the simpler reading is kept")
+            score = rss2 / s2 + (n_par - h.n_params + 1) * math.log(N)
+            out = []
+            for x, t2, d2 in zip(others + [None], th2, sd2):
+                xh = g if x is None else x.hypothesis
+                vec = np.ndim(t2) > 0
+                t0, d0 = (float(t2[0]), float(d2[0])) if vec else (float(t2), float(d2))
+                f = Finding(xh.kind, xh.station, xh.element, t0, xh.unit, d0, score,
+                            e.delta_chi2 if x is None else x.delta_chi2, xh.description, True, False,
+                            None if (xh.gain is not None or xh.added) else xh.nominal + t0, xh)
+                if vec:
+                    f.values, f.stds = tuple(float(v) for v in t2), tuple(float(v) for v in d2)
+                out.append(f)
+            return out[:k] + [out[-1]] + out[k:-1]
+    return effects
 
 
 def _data_sets(rec, allf, chans, vchans):

@@ -68,6 +68,11 @@ class Hypothesis:
     starts : list of ndarray
         Starting parameter vectors for the fit (k > 1): the best by the
         residual starts a bounded least-squares fit.
+    nested : tuple of (kind, element)
+        One-parameter hypotheses this one reduces to in a limit of its
+        parameters (a pedestal of no mass is a softer spring): with several
+        effects, the simpler reading replaces it when the data cannot tell
+        them apart (:func:`mutext.diagnose._core._simplify`).
     """
     kind: str
     station: int | None
@@ -90,6 +95,7 @@ class Hypothesis:
     change: object = None         # callable (theta vector, w) -> D(w) on dofs (k > 1)
     starts: list = field(default_factory=list, repr=False)
     run: tuple = ()               # the elements of a run (distributed kinds), in order
+    nested: tuple = ()            # (kind, element) of the one-parameter hypotheses it reduces to (k > 1)
 
     @property
     def n_params(self) -> int:

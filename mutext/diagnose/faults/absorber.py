@@ -82,7 +82,8 @@ def candidates(model) -> list[Hypothesis]:
         p0 = params[0]
         out.append(Hypothesis("absorber", i, f"absorber_{name}", f"tuned-mass absorber added at {name}", "kg",
                               True, p0.lower, p0.upper, p0.scale, [i - 1], np.ones((1, 1)), 0,
-                              parameter=None, nominal=0.0, params=params, change=_change, starts=starts))
+                              parameter=None, nominal=0.0, params=params, change=_change, starts=starts,
+                              nested=(("mass", name),)))          # k_a -> infinity: the host's mass changed
     return out
 
 

@@ -72,7 +72,7 @@ def candidates(model) -> list[Hypothesis]:
         out.append(Hypothesis("pedestal", i, el.name, f"spring {el.name} ({name}-ground) on a pedestal", "kg",
                               True, params[0].lower, params[0].upper, params[0].scale, [i - 1], np.ones((1, 1)),
                               0, parameter=None, nominal=0.0, params=params, change=change_of(kg),
-                              starts=starts))
+                              starts=starts, nested=(("stiffness", el.name),)))   # m_p -> 0: a softer spring
     return out
 
 
