@@ -239,7 +239,7 @@ def _bfgs(fun, x0, B0=None, max_iter: int = 100, ftol: float = 1e-10, max_step: 
     point found, still a valid bound).  Returns (f, x, inverse Hessian
     approximation, evaluations); ``info["stop"]`` (if given) says why it stopped:
     ``"ftol"`` (converged), ``"stall"`` (the line search failed, typically at a kink of
-    the largest eigenvalue) or ``"budget"``.
+    the largest eigenvalue) or ``"budget"``; ``info["moved"]`` whether any step was taken.
     """
     x = x0.copy()
     f, g = fun(x)
@@ -249,6 +249,7 @@ def _bfgs(fun, x0, B0=None, max_iter: int = 100, ftol: float = 1e-10, max_step: 
     reset = B0 is None
     small = 0
     stop = "budget"
+    moved = False
     for _ in range(max_iter):
         if nev >= max_eval:
             break
@@ -284,6 +285,7 @@ def _bfgs(fun, x0, B0=None, max_iter: int = 100, ftol: float = 1e-10, max_step: 
                 x, f = xt, ft
                 g = fun(x)[1]
                 nev += 1
+                moved = True
             if reset:
                 stop = "stall"
                 break
@@ -293,6 +295,7 @@ def _bfgs(fun, x0, B0=None, max_iter: int = 100, ftol: float = 1e-10, max_step: 
             continue
         s, y = t * p, gt - g
         drop = f - ft
+        moved = True
         x, f, g = xt, ft, gt
         sy = float(s @ y)
         if sy > 1e-14 * float(s @ s):
@@ -305,6 +308,7 @@ def _bfgs(fun, x0, B0=None, max_iter: int = 100, ftol: float = 1e-10, max_step: 
             break
     if info is not None:
         info["stop"] = stop
+        info["moved"] = moved
     return f, x, B, nev
 
 
@@ -406,6 +410,10 @@ def _fast_default(M, S: BlockStructure, params: _DGParams, always: bool = False)
     nev = up.iterations
     for _ in range(_FAST_RESTARTS):
         if x is None or (info.get("stop") == "ftol" and not always):
+            break
+        if not info.get("moved", True):
+            # no step taken from x with a fresh Hessian approximation: a restart from x
+            # would repeat the same failed line search
             break
         up2, x2, _ = _fast_at(M, S, params, x, None, ftol=_AUTO_FTOL, max_eval=200, info=info)
         nev += up2.iterations

@@ -161,7 +161,8 @@ def mu_upper(M, structure: BlockStructure, *, method: str = "auto", real: str = 
         return MuUpper(float(up.value * nrm), up.method, d=up.d, Dl=up.Dl, Dr=up.Dr,
                        G=None if up.G is None else up.G * nrm, iterations=up.iterations,
                        lower_level=float(up.lower_level * nrm) if up.lower_level is not None else None)
-    if nrm == 0 or (len(S) == 1 and S.blocks[0].kind == "full"):
+    if nrm == 0 or (len(S) == 1 and S.blocks[0].kind != "real" and S.blocks[0].diagonal_scaling):
+        # one full block or one complex 1 x 1 scalar: mu = sigma_max(M)
         return _diag_result(M, S, np.ones(len(S)), "sigma")
     if method == "osborne":
         _, d_os, it_os = _upper_osborne(M, S)
