@@ -41,10 +41,11 @@ def chain_model(path):
 
 @pytest.mark.slow
 def test_hammer_test_against_the_wrong_model_is_not_explained(tmp_path, capsys):
-    # about two minutes of CPU (every kind of the library screened at the eleven stations); covered in the default run by tests/test_analyzer_files.py (this export read,
-    # converted, its resonance table), tests/test_uff.py::test_command_line_diagnose_reads_every_frf_of_a_uff_file
-    # (diagnose on a UFF file from the command line) and
-    # tests/test_diagnose_open.py::test_not_explained_result_writes_no_fix (a wrong model: no fix written)
+    # about two minutes of CPU (every kind of the library screened at the eleven stations); covered in the
+    # default run by tests/test_analyzer_files.py (this export read, converted, its resonance table),
+    # tests/test_uff.py::test_command_line_diagnose_reads_every_frf_of_a_uff_file (diagnose on a UFF file
+    # from the command line) and tests/test_diagnose_open.py::test_not_explained_result_writes_no_fix
+    # (a wrong model: no fix written)
     truth = write_hammer_test(tmp_path / "hammer.uff", seed=1, noise=0.01, lines=400)
     model = chain_model(tmp_path / "chain.toml")
     # 1. convert (notes on stderr: the 0 Hz line, the Latin-1 label, accelerance -> receptance)

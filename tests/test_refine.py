@@ -287,7 +287,9 @@ def test_scalings_of_a_parameter_that_barely_matters_stay_usable():
     assert pt.value == pytest.approx(witness, rel=1e-6)
 
 
-@pytest.mark.parametrize("x_max, upper, lower", [(0.041, 0.97814, 0.97812), (0.035, 1.10267, 1.10266)])
+# the 0.035 m controller is slow: covered in the default run by the 0.041 m one (the same independent judge)
+@pytest.mark.parametrize("x_max, upper, lower", [(0.041, 0.97814, 0.97812),
+                                                 pytest.param(0.035, 1.10267, 1.10266, marks=pytest.mark.slow)])
 def test_stored_refined_controllers_have_the_bounds_their_documentation_states(x_max, upper, lower):
     """The controllers of the book's longest refinements (``tmu.refined_controller``), judged
     without mutext: the loop closed by python-control and stable by its poles in 40 digits,
