@@ -138,7 +138,11 @@ def _check_trial(name, res, rtol):
         assert np.all(err <= 1.05 * res.bound())
 
 
+@pytest.mark.slow
 def test_identify_spring_trial_1a():
+    # covered in the default run by test_identify_from_a_measured_frf_file (identify on trial 1a: the
+    # W_z search, the hidden spring read from K); the controlled model against every true rig is
+    # checked with the other trials (test_identify_trial, slow)
     buf = io.StringIO()
     res = identify(**tm.mbi_arguments(tm.TRIALS["1a"]), Wz=tm.TRIALS["1a"].Wz, out=buf)
     _check_trial("1a", res, 0.05)
