@@ -32,7 +32,11 @@ File format
   Optional: ``speed_hz`` (float, running speed), ``input_direction`` and
   ``output_direction`` (``x`` or ``y``, the plane of a rotor; default ``x``),
   ``input_name`` and ``output_name`` (the model's port names).  Any other ``# key: value`` is kept
-  as metadata (strings).  Keys are case-sensitive and may appear once.
+  as metadata (strings).  A combination-frequency response (a time-periodic
+  rotor's response at :math:`f + kF` to excitation at :math:`f`, written by
+  :func:`measure_rotor` with ``combination=``) says so with ``order: k``
+  (integer, not 0) and ``response_frequency: f_exc + k * speed_hz``; its rows
+  are on the excitation frequency and it needs ``speed_hz``.  Keys are case-sensitive and may appear once.
 * Then the CSV header line ``freq_hz,re,im`` and one row per frequency:
   frequency in Hz (strictly increasing) and the real and imaginary parts of
   the response in ``output_unit`` per ``input_unit`` (e.g. um/A).  Blank
@@ -701,18 +705,30 @@ def measure(system, in_port=0, out_port=0, freq_hz=None, *, noise=None, rng=None
 
 def measure_rotor(model, in_port: str, out_port: str, freq_hz=None, *, noise=None, rng=None,
                   harmonics: int = 6, cutoff_hz: float = 1000.0, revolutions: int = 40,
-                  settle_s: float = 0.7, metadata: Mapping[str, str] | None = None) -> FRF:
+                  settle_s: float = 0.7, metadata: Mapping[str, str] | None = None,
+                  combination: Sequence[int] | None = None, speed_hz: float | None = None):
     r"""Virtual sine sweep of a finite-element rotor, as the rig's analyzer measures it.
 
     A rotor without a breathing crack is time-invariant: the measurement is
     its exact frequency response (:func:`mutext.rotor.analysis.frf`).  With a
-    breathing crack (``breathing = "mayes"``, ``"gasch"`` or ``"open"`` in the
-    model file) and a running speed, the rotor is time-periodic and the
+    breathing crack (``breathing = "mayes"``, ``"gasch"`` or ``"gaping"`` in
+    the model file) and a running speed, the rotor is time-periodic and the
     measurement is the analyzer's correlation of the response with the
     excitation (:func:`mutext.rotor.periodic.analyzer_frf`: harmonic balance
     with ``harmonics`` terms either side, on the Ritz-reduced model below
     ``cutoff_hz``; the reduction error is stored in the metadata), which
     shows the sidebands a time-invariant model cannot hold.
+
+    With ``combination`` (orders :math:`k`, e.g. ``(-2, -1, 1, 2)``) the
+    analyzer also correlates the response at the combination frequencies
+    :math:`f + kF` (:func:`mutext.rotor.periodic.analyzer_combination`, the
+    off-diagonal harmonic transfer functions: the time-periodic rotor's
+    first-order signature); a time-invariant rotor gives zero there.  The
+    noise of such a channel is the noise of the excitation-frequency channel
+    at the same step in absolute terms, :math:`\sigma = r|\hat H_0| + s`
+    (same sensor, same correlation length; the relative level ``r`` is not
+    applied to the much smaller combination response, which would make it
+    look cleaner than it is).
 
     Parameters
     ----------
@@ -726,19 +742,45 @@ def measure_rotor(model, in_port: str, out_port: str, freq_hz=None, *, noise=Non
     harmonics, cutoff_hz, revolutions, settle_s
         Harmonic-balance truncation, reduction cutoff [Hz] and the analyzer's
         correlation length and settling time (thesis: 40 revolutions, 700 ms).
+    combination : sequence of int, optional
+        Orders :math:`k \ne 0` to record besides the excitation frequency.
+    speed_hz : float, optional
+        Running speed [Hz] (default: the model's).
 
     Returns
     -------
-    FRF
+    FRF, or list of FRF with ``combination``
         With the ports' stations, directions and quantities and the speed.
+        With ``combination``: the excitation-frequency FRF first, then one
+        per order, whose metadata holds ``order`` and
+        ``response_frequency``.
     """
-    from .rotor.periodic import analyzer_frf, periodic_rotor
+    from .rotor.periodic import analyzer_combination, analyzer_frf, periodic_rotor
     f = sweep_frequencies() if freq_hz is None else np.asarray(freq_hz, dtype=float).ravel()
-    pr = periodic_rotor(model, inputs=[in_port], outputs=[out_port])
+    orders = None
+    if combination is not None:
+        orders = []
+        for k in combination:
+            if isinstance(k, bool) or not isinstance(k, (int, np.integer)) or k == 0:
+                raise ModelError(f"measure_rotor: combination orders must be non-zero integers (k of "
+                                 f"f + k F), got {k!r}")
+            orders.append(int(k))
+        if not orders or len(set(orders)) != len(orders):
+            raise ModelError(f"measure_rotor: combination must list distinct non-zero orders, got {combination!r}")
+    speed = None
+    if speed_hz is not None:
+        if isinstance(speed_hz, bool) or not isinstance(speed_hz, (int, float)) or not (
+                math.isfinite(speed_hz) and speed_hz >= 0):
+            raise ModelError(f"measure_rotor: speed_hz must be a running speed >= 0 [Hz], got {speed_hz!r}")
+        speed = 2.0 * math.pi * float(speed_hz)
+    pr = periodic_rotor(model, inputs=[in_port], outputs=[out_port], speed=speed)
     meta = {str(k): str(v) for k, v in (metadata or {}).items()}
+    combos = {}
     if pr.time_invariant():
-        H = model.frf(f, inputs=[in_port], outputs=[out_port])
+        H = model.frf(f, inputs=[in_port], outputs=[out_port], **({} if speed is None else {"speed": speed}))
         meta.setdefault("analyzer", "time-invariant model: exact frequency response")
+        if orders:
+            combos = {k: np.zeros(f.size, complex) for k in orders}
     else:
         red = pr.reduce(cutoff_hz, band_hz=(float(f.min()), float(f.max())))
         H = analyzer_frf(red, f, harmonics=harmonics, revolutions=revolutions, settle_s=settle_s)
@@ -746,9 +788,36 @@ def measure_rotor(model, in_port: str, out_port: str, freq_hz=None, *, noise=Non
                                  f"{settle_s:g} s settling; harmonic balance N = {harmonics}",
                      "breathing": ", ".join(f"{c.name} {c.law}" for c in pr.cracks),
                      "reduction_error": f"{red.reduction_error:.3g}"})
+        if orders:
+            combos = {k: v.H[0, 0] for k, v in analyzer_combination(
+                red, f, orders, harmonics=harmonics, revolutions=revolutions, settle_s=settle_s).items()}
     ch = H.channel(out_port, in_port)
+    if speed is not None:
+        ch.speed_hz = float(speed_hz)
     ch.metadata = meta
-    return with_noise(ch, noise, rng=rng)
+    if not orders:
+        return with_noise(ch, noise, rng=rng)
+    gen = rng if isinstance(rng, np.random.Generator) else np.random.default_rng(rng)
+    main = with_noise(ch, noise, rng=gen)
+    out = [main]
+    nz = _as_noise(noise)
+    F = ch.speed_hz
+    for k in orders:
+        G = np.asarray(combos[k], complex)
+        m = dict(meta, order=str(k), response_frequency=f"f_exc {'+' if k > 0 else '-'} {abs(k)} x {F:g} Hz")
+        if nz is not None and (nz.relative > 0 or nz.floor > 0):
+            sigma = nz.relative * np.abs(ch.response) + nz.floor
+            G = G + sigma * (gen.standard_normal(G.size) + 1j * gen.standard_normal(G.size)) / np.sqrt(2.0)
+            m["noise_relative"] = repr(nz.relative)
+            m["noise_floor"] = repr(nz.floor)
+            m["noise_reference"] = "the excitation-frequency response (absolute noise of the main channel)"
+        c = FRF(freq_hz=ch.freq_hz.copy(), response=G, input_station=ch.input_station,
+                output_station=ch.output_station, input_quantity=ch.input_quantity,
+                output_quantity=ch.output_quantity, speed_hz=F, metadata=m,
+                input_direction=ch.input_direction, output_direction=ch.output_direction)
+        c.input_name, c.output_name = ch.input_name, ch.output_name
+        out.append(c)
+    return out
 
 
 def with_noise(frf: FRF, noise=None, *, rng=None) -> FRF:

@@ -13,8 +13,8 @@ from mutext.errors import ModelError
 from mutext.rig import measure_rotor
 from mutext.rotor import data_path, loads_model
 from mutext.rotor.crack import breathing_fourier, breathing_weights
-from mutext.rotor.periodic import (analyzer_frf, harmonic_convergence, harmonic_response, periodic_rotor,
-                                   stepped_sine)
+from mutext.rotor.periodic import (analyzer_combination, analyzer_frf, harmonic_convergence, harmonic_response,
+                                   periodic_rotor, stepped_sine)
 
 TEXT = open(data_path("rotor.toml")).read()
 
@@ -155,3 +155,66 @@ def test_crack_quadrature_points_are_checked():
         rotor("[[crack]]\nstation = 15\ndepth_ratio = 0.4\nn_quad = 0\n")
     with pytest.raises(ModelError, match="n_quad"):
         crack_compliance_dimensionless(0.3, n_quad=0)
+
+
+# ----------------------------------------------------------------------------
+# combination frequencies f + k F (the off-diagonal harmonic transfer functions)
+# ----------------------------------------------------------------------------
+
+def test_combination_responses_are_the_off_diagonal_htfs(mayes):
+    _, _, red = mayes
+    f = np.array([23.5, 25.0, 43.5, 80.0])
+    hb = analyzer_combination(red, f, (-2, -1, 0, 1, 2), harmonics=6)
+    hr = harmonic_response(red, f, harmonics=8)
+    # order 0 is the analyzer's FRF; away from 2 f = m F the window terms vanish and H_k remains
+    assert np.allclose(hb[0].H, analyzer_frf(red, f, harmonics=8).H, rtol=1e-12, atol=0)
+    away = [0, 2, 3]
+    for k in (-2, -1, 1, 2):
+        assert np.allclose(hb[k].H[0, 0, away], hr(k)[0, 0, away], rtol=1e-9, atol=0)
+    # at 25 Hz (2 f = 5 F) the window term changes H_-1 by tens of percent: the check can fail
+    assert abs(hb[-1].H[0, 0, 1] - hr(-1)[0, 0, 1]) > 0.1 * abs(hr(-1)[0, 0, 1])
+    # a gaping notch varies at 2x only: no response at f +/- F, a clear one at f +/- 2 F
+    gap = periodic_rotor(cracked("gaping"), inputs=["i12"], outputs=["x13"]).reduce(1000.0)
+    g = analyzer_combination(gap, f[[0, 2]], (-1, 1, 2))
+    h0 = np.abs(analyzer_frf(gap, f[[0, 2]]).H[0, 0])
+    assert np.all(np.abs(g[1].H[0, 0]) < 1e-12 * h0) and np.all(np.abs(g[-1].H[0, 0]) < 1e-12 * h0)
+    assert np.all(np.abs(g[2].H[0, 0]) > 1e-3 * h0)
+    with pytest.raises(ModelError, match="orders must be integers"):
+        analyzer_combination(red, f, (1.5,))
+
+
+@pytest.mark.slow
+def test_combination_responses_agree_with_time_integration(mayes):
+    # the analyzer in software: the response correlated at f + k F after 6 s settling
+    _, _, red = mayes
+    f = np.array([23.5, 25.0, 43.5, 80.0])
+    hb = analyzer_combination(red, f, (-2, -1, 1, 2), settle_s=6.0, revolutions=10, excitation_phase=0.7)
+    td = stepped_sine(red, f, settle_s=6.0, revolutions=10, excitation_phase=0.7, orders=(-2, -1, 1, 2))
+    for k in (-2, -1, 1, 2):
+        a, b = hb[k].H[0, 0], td["H_orders"][k]
+        assert np.all(np.abs(b - a) < 1e-3 * np.abs(a)), (k, np.abs(b - a) / np.abs(a))
+        assert np.all(np.abs(a) > 1e-3 * np.abs(td["H"]))      # far above the tolerance
+
+
+def test_measure_rotor_records_combination_channels(tmp_path):
+    from mutext.rig import read_frf, write_frf
+    r = cracked()
+    f = np.arange(30.0, 40.01, 0.5)
+    chans = measure_rotor(r, "i12", "x13", f, combination=(-1, 1), speed_hz=12.0)
+    assert [c.metadata.get("order") for c in chans] == [None, "-1", "1"]
+    assert all(c.speed_hz == 12.0 for c in chans)
+    ref = analyzer_combination(periodic_rotor(r, inputs=["i12"], outputs=["x13"], speed=2 * np.pi * 12.0)
+                               .reduce(1000.0, band_hz=(30.0, 40.0)), f, (-1, 1))
+    assert np.allclose(chans[2].response, ref[1].H[0, 0], rtol=1e-9)
+    back = read_frf(write_frf(tmp_path / "c.csv", chans[1]))
+    assert back.metadata["order"] == "-1" and back.speed_hz == 12.0
+    # a time-invariant rotor: zero at the combination frequencies, only the noise there
+    clean = measure_rotor(rotor(), "i12", "x13", f, combination=(1,))
+    assert np.all(clean[1].response == 0)
+    noisy = measure_rotor(rotor(), "i12", "x13", f, combination=(1,), noise=0.01, rng=1)
+    ratio = np.abs(noisy[1].response) / np.abs(noisy[0].response)
+    assert 0.002 < np.median(ratio) < 0.02
+    with pytest.raises(ModelError, match="combination"):
+        measure_rotor(r, "i12", "x13", f, combination=(0,))
+    with pytest.raises(ModelError, match="speed_hz"):
+        measure_rotor(r, "i12", "x13", f, speed_hz=-1.0)

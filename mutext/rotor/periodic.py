@@ -49,6 +49,25 @@ of :math:`\Omega`.  The sidebands make the measured FRF resonate where
 :math:`\omega \pm k\Omega` meets a natural frequency, which no
 time-invariant model can reproduce.
 
+**Combination frequencies.**  The first-order signature of the
+time-periodic rotor is not in :math:`\hat H` (where it enters only through
+the resonances of the small :math:`H_{k\ne0}` terms folded back) but at the
+combination frequencies :math:`\omega + k\Omega` themselves: an analyzer
+that also correlates the response with :math:`e^{-j((\omega + k\Omega)t +
+\varphi)}` (the rotor's angle known from a once-per-revolution mark)
+measures
+
+.. math::
+    \hat H_k(\omega) = H_k(\omega) + e^{-2j\varphi}\sum_{k'} \overline{H_{k'}(\omega)}\;
+    \frac{1}{T}\int_{t_s}^{t_s+T} e^{-j(2\omega + (k + k')\Omega)t}dt
+
+(:func:`analyzer_combination`; :math:`k = 0` is :math:`\hat H`).  Over whole
+revolutions the excitation line itself averages out exactly, so
+:math:`\hat H_k` is the off-diagonal harmonic transfer function, of the
+order of the crack's stiffness change, where :math:`\hat H` holds it only
+squared (a sideband is :math:`H_{-k}` turned back by a second pass through the
+crack) or near the resonances :math:`\omega + k\Omega = \omega_n`.
+
 **Brute force.**  :func:`stepped_sine` integrates the same equations in time
 (fourth-order Runge-Kutta on a modal basis, the breathing law evaluated
 directly, not through its Fourier series), with the analyzer's settling time
@@ -82,7 +101,7 @@ from .analysis import _port_info, _ports, _speed
 from .crack import breathing_fourier, breathing_weights
 
 __all__ = ["PeriodicRotor", "HarmonicResponse", "periodic_rotor", "harmonic_response", "analyzer_frf",
-           "stepped_sine", "harmonic_convergence", "ANALYZER"]
+           "analyzer_combination", "stepped_sine", "harmonic_convergence", "ANALYZER"]
 
 #: The thesis's sweep settings (sec. 4.3): 0.1 A, 40 revolutions per correlation, 700 ms settling.
 ANALYZER = {"amplitude": 0.1, "revolutions": 40, "settle_s": 0.7}
@@ -454,6 +473,52 @@ def analyzer_frf(model, freqs_hz, *, harmonics: int = 6, revolutions: int = ANAL
     return FRFMatrix(hr.freqs_hz, H, list(pr.inputs), list(pr.outputs), pr.speed, dict(pr.ports))
 
 
+def analyzer_combination(model, freqs_hz, orders=(-2, -1, 1, 2), *, harmonics: int = 6,
+                         revolutions: int = ANALYZER["revolutions"], settle_s: float = ANALYZER["settle_s"],
+                         excitation_phase: float = 0.0, inputs=None, outputs=None) -> dict:
+    r"""Combination-frequency responses :math:`\hat H_k` a stepped-sine analyzer records (steady state).
+
+    For each excitation frequency :math:`\omega` and each order ``k`` in
+    ``orders``, the response correlated at :math:`\omega + k\Omega` over
+    ``revolutions`` turns after ``settle_s`` (module docstring):
+    :math:`\hat H_k = H_k + e^{-2j\varphi}\sum_{k'}\overline{H_{k'}}\,
+    \langle e^{-j(2\omega + (k+k')\Omega)t}\rangle`.  ``k = 0`` gives
+    :func:`analyzer_frf`.  The phase is referred to the rotor at its angle
+    zero at :math:`t = 0` (a keyphasor).  The harmonic balance is solved
+    with ``harmonics + max|k|`` terms either side, so that the window terms
+    of order ``k`` reach as far as those of :func:`analyzer_frf` (where
+    :math:`2f` is a multiple of the speed, order ``k`` draws on
+    :math:`H_{-k-2f/F}`).
+
+    Returns
+    -------
+    dict
+        ``{k: FRFMatrix}``, each on the excitation frequencies ``freqs_hz``
+        (the response is at ``freqs_hz + k * speed / 2 pi``).
+    """
+    pr = _as_periodic(model, inputs, outputs)
+    ks = []
+    for k in orders:
+        if isinstance(k, bool) or not isinstance(k, (int, np.integer)):
+            raise ModelError(f"orders must be integers (the k of f_exc + k F), got {k!r}")
+        ks.append(int(k))
+    if not ks:
+        raise ModelError("orders must name at least one order k")
+    N = _harmonics(harmonics)
+    N = N + max(abs(k) for k in ks)
+    hr = harmonic_response(pr, freqs_hz, harmonics=N)
+    t_s, T = _settle(pr, settle_s, revolutions)
+    w = 2 * np.pi * hr.freqs_hz
+    out = {}
+    for k in ks:
+        H = hr(k).copy()
+        for kp in range(-N, N + 1):
+            avg = _window_average(-(2 * w + (k + kp) * pr.speed), t_s, T)
+            H += np.exp(-2j * excitation_phase) * np.conj(hr(kp)) * avg
+        out[k] = FRFMatrix(hr.freqs_hz, H, list(pr.inputs), list(pr.outputs), pr.speed, dict(pr.ports))
+    return out
+
+
 def harmonic_convergence(model, freqs_hz, *, harmonics: Sequence[int] = (0, 1, 2, 3, 4, 6, 8),
                          inputs=None, outputs=None) -> list[dict]:
     """How :math:`H_0` settles as the truncation grows: for each N, the largest change
@@ -513,7 +578,8 @@ def _port_index(names, name, kind: str) -> int:
 def stepped_sine(model, freqs_hz, *, in_port: str | None = None, out_port: str | None = None,
                  amplitude: float = ANALYZER["amplitude"], revolutions: int = ANALYZER["revolutions"],
                  settle_s: float = ANALYZER["settle_s"], excitation_phase: float = 0.0,
-                 steps_per_rev: int | None = None, cutoff_hz: float = 1500.0, progress=None) -> dict:
+                 steps_per_rev: int | None = None, cutoff_hz: float = 1500.0, progress=None,
+                 orders: Sequence[int] = ()) -> dict:
     r"""Brute-force stepped-sine measurement by time integration (the analyzer, in software).
 
     Each frequency starts from rest with the rotor at angle zero, is driven
@@ -527,13 +593,16 @@ def stepped_sine(model, freqs_hz, *, in_port: str | None = None, out_port: str |
     by the classical Runge-Kutta method with ``steps_per_rev`` steps per turn
     (default: the stability limit of the stiffest basis vector with a margin,
     and at least 40 steps per period of the response); the breathing laws are evaluated at every stage, so the check does
-    not rely on their Fourier series.
+    not rely on their Fourier series.  ``orders`` adds the correlations at
+    the combination frequencies :math:`\omega + k\Omega` (the independent
+    check of :func:`analyzer_combination`).
 
     Returns
     -------
     dict
         ``freqs_hz``, ``H`` (complex, output unit per input unit), ``steps_per_rev``,
-        ``settle_s`` (as used), ``seconds``, ``n_modes``.
+        ``settle_s`` (as used), ``seconds``, ``n_modes``; with ``orders``,
+        ``H_orders`` = ``{k: response at f + k F per input unit}``.
     """
     t0 = time.perf_counter()
     pr = model if isinstance(model, PeriodicRotor) else periodic_rotor(model)
@@ -564,6 +633,8 @@ def stepped_sine(model, freqs_hz, *, in_port: str | None = None, out_port: str |
     c_out = np.zeros(2 * r)
     c_out[:r] = pr.Cy[oi]
     acc = np.zeros(f.size, complex)
+    korders = [int(k) for k in orders]
+    acc_k = {k: np.zeros(f.size, complex) for k in korders}
     ph = excitation_phase
     total = n_settle + n_rec
     report = max(1, total // 20)
@@ -574,11 +645,16 @@ def stepped_sine(model, freqs_hz, *, in_port: str | None = None, out_port: str |
             U = amplitude * np.cos(np.outer([tn, tn + 0.5 * h, tn + h], w) + ph)
             Z = F[j] @ Z + g[j] @ U
             if step + 1 > n_settle:
-                acc += (c_out @ Z) * np.exp(-1j * (w * (step + 1) * h + ph))
+                y = c_out @ Z
+                tt = (step + 1) * h
+                acc += y * np.exp(-1j * (w * tt + ph))
+                for k in korders:
+                    acc_k[k] += y * np.exp(-1j * ((w + k * pr.speed) * tt + ph))
             if progress is not None and step % report == 0:
                 progress(step / total)
     # rectangle rule over whole periods: samples at t_s + h, ..., t_s + T (periodic integrand)
     H = 2.0 * acc / (amplitude * n_rec)
-    return {"freqs_hz": f, "H": H, "steps_per_rev": P, "settle_s": n_settle * h, "seconds":
+    extra = {"H_orders": {k: 2.0 * a / (amplitude * n_rec) for k, a in acc_k.items()}} if korders else {}
+    return {**extra, "freqs_hz": f, "H": H, "steps_per_rev": P, "settle_s": n_settle * h, "seconds":
             time.perf_counter() - t0, "n_modes": r, "input": pr.inputs[ii], "output": pr.outputs[oi],
             "reduction_error": pr.reduction_error}
