@@ -64,6 +64,35 @@ class _DGParams:
             self.El = np.eye(self.m)[S.col_block]
             self.Er = np.eye(self.m)[S.row_block]
 
+    #: set by the caller: value_grad then also keeps the first-order model of the top two
+    #: eigenvalues (diagonal scalings only) in ``cluster``
+    want_cluster = False
+    cluster = None
+
+    def _cluster(self, A, w, V, beta0, gs, x):
+        r"""First-order model of the two largest eigenvalues of H, divided by the largest:
+        (w1/w0, C) with C[k] = Q^H (dH/dx_k) Q / w0 (2 x 2, all coordinates), Q the two top
+        eigenvectors (largest first).  With ``A`` and ``Y = AQ - j G'^H Q``,
+        :math:`Q^H\partial_kHQ = R_k^HY + Y^HR_k`, :math:`R_k = \partial_kA\,Q`."""
+        if w.size < 2 or not w[-1] > 0:
+            return None
+        Q = V[:, :-3:-1]
+        P = A @ Q
+        Y = P.copy()
+        if gs is not None:
+            Y[self.gcol] -= 1j * (beta0 * gs)[:, None] * Q[self.grow]
+        AY = A.conj().T @ Y
+        # R_k^H Y summed over the rows of block k: columns (col_block) and rows (row_block)
+        T = (np.einsum("ia,ib->iab", P.conj(), Y).reshape(P.shape[0], 4).T @ self.El
+             - np.einsum("ia,ib->iab", Q.conj(), AY).reshape(Q.shape[0], 4).T @ self.Er)
+        T = T.T.reshape(self.m, 2, 2)
+        C = np.empty((self.size, 2, 2), complex)
+        C[:self.m] = T + T.conj().transpose(0, 2, 1)
+        if gs is not None:
+            X = np.einsum("ja,jb->jab", Q[self.grow].conj(), P[self.gcol])
+            C[self.m:] = (1j * beta0 * np.cosh(x[self.m:]))[:, None, None] * (X - X.conj().transpose(0, 2, 1))
+        return float(w[-2] / w[-1]), C / w[-1]
+
     # -- small matrices from coordinates -------------------------------------
     @staticmethod
     def _lower(p, n):
@@ -132,6 +161,8 @@ class _DGParams:
             lam, v = float(w[-1]), V[:, -1]
             if not grad:
                 return lam, None
+            if self.want_cluster:
+                self.cluster = self._cluster(A, w, V, beta0, gs if self.nreal else None, x)
             a = A @ v
             g = np.empty(self.size)
             g[:m] = 2.0 * ((a.real ** 2 + a.imag ** 2) @ self.El - lam * ((v.real ** 2 + v.imag ** 2) @ self.Er))
@@ -227,8 +258,66 @@ class _DGParams:
         return Dl, Dr, G
 
 
+#: relative gap of the two largest eigenvalues below which the descent steps on their
+#: first-order model (the kink of lambda_max) instead of the gradient of the largest
+_CLUSTER_GAP = 0.05
+
+
+def _cluster_step(cl, B):
+    r"""Step on the model of the two largest eigenvalues (Overton's idea, for a cluster of two).
+
+    ``cl = (r, C)``: :math:`\lambda_2/\lambda_1` and the ``2 x 2`` matrices
+    :math:`C_k = Q^H\partial_kHQ/\lambda_1`.  The model of :math:`\lambda_{\max}/\lambda_1`
+    is :math:`c(d) + \|\rho(d)\|` (the largest eigenvalue of a ``2 x 2`` Hermitian
+    matrix, affine in the step :math:`d`); the step minimises it plus
+    :math:`\frac12 d^TB^{-1}d`.  Its dual is a concave quadratic on the unit ball of
+    :math:`\mathbb R^3` (a trust-region problem solved by the secular equation), and
+    :math:`d = -B(g_c + J^Tu)`.  Returns (d, predicted change of the model).
+    """
+    r, C = cl
+    gc = 0.5 * (C[:, 0, 0].real + C[:, 1, 1].real)
+    J = np.array([0.5 * (C[:, 0, 0].real - C[:, 1, 1].real), C[:, 0, 1].real, C[:, 0, 1].imag])
+    r0 = np.array([0.5 * (1.0 - r), 0.0, 0.0])
+    BJ = B @ J.T
+    Q3 = J @ BJ
+    Q3 = 0.5 * (Q3 + Q3.T)
+    b = r0 - BJ.T @ gc
+    q, V = np.linalg.eigh(Q3)
+    bb = V.T @ b
+    top = float(q[-1])
+    nb = float(np.linalg.norm(b))
+    if not top > 1e-14 * nb:
+        # the model's curvature vanishes (or is negligible): the linear part alone
+        u = b / nb if nb > 0 else np.zeros(3)
+    elif q[0] > 1e-12 * top and float(np.sum((bb / q) ** 2)) <= 1.0:
+        u = V @ (bb / q)
+    else:
+        # ||(Q3 + mu I)^-1 b|| = 1: Newton on 1 / ||u(mu)|| (More and Sorensen)
+        mu0 = max(0.0, -float(q[0]))
+        mu = mu0 + 1e-12 * top
+        for _ in range(60):
+            z = bb / (q + mu)
+            nu = float(np.sqrt(z @ z))
+            if not nu > 0:
+                break
+            dn = -float(z @ (z / (q + mu))) / nu
+            step = (1.0 / nu - 1.0) * nu * nu / dn
+            mu_new = max(mu + step, mu0 + 0.5 * (mu - mu0))
+            if abs(mu_new - mu) <= 1e-14 * max(mu, 1e-300):
+                mu = mu_new
+                break
+            mu = mu_new
+        u = V @ (bb / (q + mu))
+        nu = float(np.sqrt(u @ u))
+        if nu > 1.0:
+            u = u / nu
+    d = -(B @ gc + BJ @ u)
+    pred = 0.5 * (r - 1.0) + float(gc @ d) + float(np.linalg.norm(r0 + J @ d))
+    return d, pred
+
+
 def _bfgs(fun, x0, B0=None, max_iter: int = 100, ftol: float = 1e-10, max_step: float = 1.0,
-          max_eval: int = 400, info: dict | None = None):
+          max_eval: int = 400, info: dict | None = None, cluster=None):
     r"""Minimise a (possibly nonsmooth at optimum) function by BFGS with a weak Wolfe line search.
 
     The line search of Lewis and Overton [LO]_ (bisection/doubling on the
@@ -240,9 +329,14 @@ def _bfgs(fun, x0, B0=None, max_iter: int = 100, ftol: float = 1e-10, max_step: 
     approximation, evaluations); ``info["stop"]`` (if given) says why it stopped:
     ``"ftol"`` (converged), ``"stall"`` (the line search failed, typically at a kink of
     the largest eigenvalue) or ``"budget"``; ``info["moved"]`` whether any step was taken.
+    ``cluster`` (optional) returns the model of the two largest eigenvalues at the point
+    last evaluated (see :func:`_cluster_step`); where their gap is below ``_CLUSTER_GAP``
+    the step is taken on that model (Armijo backtracking on its predicted decrease), with
+    the gradient step as fallback.
     """
     x = x0.copy()
     f, g = fun(x)
+    cl = cluster() if cluster is not None else None
     nev = 1
     n = x.size
     B = np.eye(n) if B0 is None else B0.copy()
@@ -253,6 +347,40 @@ def _bfgs(fun, x0, B0=None, max_iter: int = 100, ftol: float = 1e-10, max_step: 
     for _ in range(max_iter):
         if nev >= max_eval:
             break
+        if not np.abs(g).max(initial=0.0) > 1e-13:
+            stop = "ftol"           # a smooth stationary point (no line search can go down)
+            break
+        if cl is not None and 1.0 - cl[0] < _CLUSTER_GAP:
+            d, pred = _cluster_step(cl, B)
+            if pred < 0 and np.all(np.isfinite(d)):
+                big = np.abs(d).max()
+                t = min(1.0, max_step / big) if big > 0 else 1.0
+                for _ls in range(8):
+                    xt = x + t * d
+                    ft, gt = fun(xt)
+                    nev += 1
+                    if ft <= f + 1e-4 * t * pred:
+                        break
+                    t *= 0.5
+                else:
+                    ft = np.inf
+                if ft < np.inf:
+                    s_, y_ = t * d, gt - g
+                    drop = f - ft
+                    moved = True
+                    x, f, g = xt, ft, gt
+                    cl = cluster()
+                    sy = float(s_ @ y_)
+                    if sy > 1e-14 * float(s_ @ s_):
+                        By = B @ y_
+                        rho = 1.0 / sy
+                        B = B + ((sy + y_ @ By) * rho * rho) * (s_[:, None] * s_) \
+                            - rho * (By[:, None] * s_ + s_[:, None] * By)
+                    small = small + 1 if drop < ftol else 0
+                    if small >= 2:
+                        stop = "ftol"
+                        break
+                    continue
         p = -B @ g
         gp = float(g @ p)
         if not gp < 0:
@@ -286,6 +414,7 @@ def _bfgs(fun, x0, B0=None, max_iter: int = 100, ftol: float = 1e-10, max_step: 
                 g = fun(x)[1]
                 nev += 1
                 moved = True
+                cl = cluster() if cluster is not None else None
             if reset:
                 stop = "stall"
                 break
@@ -297,6 +426,7 @@ def _bfgs(fun, x0, B0=None, max_iter: int = 100, ftol: float = 1e-10, max_step: 
         drop = f - ft
         moved = True
         x, f, g = xt, ft, gt
+        cl = cluster() if cluster is not None else None
         sy = float(s @ y)
         if sy > 1e-14 * float(s @ s):
             By = B @ y
@@ -319,11 +449,14 @@ _G_CLIP = 8.0
 
 
 def _upper_fast(M, S: BlockStructure, params: _DGParams, x0=None, B0=None, ftol: float = 1e-10,
-                max_eval: int = 400, info: dict | None = None, osborne_tol: float = 0.0):
+                max_eval: int = 400, info: dict | None = None, osborne_tol: float = 0.0,
+                kinks: bool = False):
     """Fast D (or D-G) bound at one matrix, from coordinates ``x0`` (None: Osborne balancing).
 
     Returns (MuUpper, x, inverse Hessian) with the value recomputed from the
     scalings' coordinates (the exact largest eigenvalue of the congruent form).
+    With ``kinks`` (diagonal scalings only) the descent steps on the model of the two
+    largest eigenvalues where they nearly coincide (:func:`_cluster_step`).
     """
     if x0 is None:
         x0 = params.initial(np.exp(_osborne(M, S, tol=osborne_tol)))
@@ -355,8 +488,17 @@ def _upper_fast(M, S: BlockStructure, params: _DGParams, x0=None, B0=None, ftol:
         if not lam > 0:
             return -np.inf, np.zeros(free.size)
         return np.log(lam), g[free]
-    with np.errstate(over="ignore", invalid="ignore"):
-        _, y, B, nev = _bfgs(fun, x0[free], B0, ftol=ftol, max_eval=max_eval, info=info)
+    cluster = None
+    if kinks and params.diag and S.nrows >= 2:
+        def cluster():
+            cl = params.cluster
+            return None if cl is None else (cl[0], cl[1][free])
+    params.want_cluster, params.cluster = cluster is not None, None
+    try:
+        with np.errstate(over="ignore", invalid="ignore"):
+            _, y, B, nev = _bfgs(fun, x0[free], B0, ftol=ftol, max_eval=max_eval, info=info, cluster=cluster)
+    finally:
+        params.want_cluster, params.cluster = False, None
     x = x0.copy()
     x[free] = y
     lam, _ = params.value_grad(x, M, beta0, grad=False)
@@ -367,17 +509,18 @@ def _upper_fast(M, S: BlockStructure, params: _DGParams, x0=None, B0=None, ftol:
 
 
 def _fast_at(M, S: BlockStructure, params: _DGParams, x0=None, B0=None, ftol: float = 1e-10,
-             max_eval: int = 400, info: dict | None = None, osborne_tol: float = 0.0):
+             max_eval: int = 400, info: dict | None = None, osborne_tol: float = 0.0,
+             kinks: bool = False):
     """:func:`_upper_fast` with the shortcuts of :func:`mu_upper` (one full block, ``M = 0``,
     extreme norms); returns (MuUpper, coordinates or None, inverse Hessian or None)."""
     nrm = _norm2(M)
     if nrm == 0 or (len(S) == 1 and S.blocks[0].kind == "full"):
         return _diag_result(M, S, np.ones(len(S)), "sigma"), None, None
     if not 1e-100 <= nrm <= 1e100:
-        up, x, B = _upper_fast(M / nrm, S, params, x0, B0, ftol, max_eval, info, osborne_tol)
+        up, x, B = _upper_fast(M / nrm, S, params, x0, B0, ftol, max_eval, info, osborne_tol, kinks)
         return MuUpper(float(up.value * nrm), up.method, d=up.d, Dl=up.Dl, Dr=up.Dr,
                        G=None if up.G is None else up.G * nrm, iterations=up.iterations), x, B
-    return _upper_fast(M, S, params, x0, B0, ftol, max_eval, info, osborne_tol)
+    return _upper_fast(M, S, params, x0, B0, ftol, max_eval, info, osborne_tol, kinks)
 
 
 def _fast_polish(M, S: BlockStructure, params: _DGParams, x0=None):
@@ -406,7 +549,7 @@ def _fast_default(M, S: BlockStructure, params: _DGParams, always: bool = False)
     Returns (MuUpper with the evaluations of all descents, coordinates or None)."""
     info = {}
     up, x, _ = _fast_at(M, S, params, None, None, ftol=_AUTO_FTOL, max_eval=300, info=info,
-                        osborne_tol=1e-2)
+                        osborne_tol=1e-2, kinks=True)
     nev = up.iterations
     for _ in range(_FAST_RESTARTS):
         if x is None or (info.get("stop") == "ftol" and not always):
@@ -415,7 +558,7 @@ def _fast_default(M, S: BlockStructure, params: _DGParams, always: bool = False)
             # no step taken from x with a fresh Hessian approximation: a restart from x
             # would repeat the same failed line search
             break
-        up2, x2, _ = _fast_at(M, S, params, x, None, ftol=_AUTO_FTOL, max_eval=200, info=info)
+        up2, x2, _ = _fast_at(M, S, params, x, None, ftol=_AUTO_FTOL, max_eval=200, info=info, kinks=True)
         nev += up2.iterations
         if not up2.value < up.value * (1 - 1e-10):
             break
