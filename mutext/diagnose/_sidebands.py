@@ -39,6 +39,37 @@ the mode itself and reported as such, not tested.  A sideband counts only
 with its mirror image: :math:`f_n - kF` found while :math:`f_n + kF` could be
 tested (in the band, not masked) and was not found is more likely a mode the
 model misplaces than a sideband, and is reported as *unpaired*.
+
+**Combination-frequency channels** (first-order evidence).  The sidebands
+above are second-order effects: in the response at the excitation frequency a
+stiffness change :math:`\Delta K` appears as :math:`\Delta K^2`, or near the
+few frequencies where :math:`f + kF` meets a mode.  An analyzer that also
+correlates the response at :math:`f + kF`
+(:func:`mutext.rig.measure_rotor` with ``combination=``, files with an
+``order: k`` header) measures the off-diagonal harmonic transfer function
+:math:`H_k`, of first order in :math:`\Delta K`, which is zero for a
+time-invariant rotor.  To first order :math:`H_k(f) = C Z(f + kF)^{-1}
+K_k Z(f)^{-1} B`, so near the modes it is a combination of the resonance
+shapes at the response frequency and at the excitation frequency,
+
+.. math::
+    H_k(f) \approx c_0 + \sum_n \big[a_n L(f + kF; f_n, \zeta_n)
+    + a_n' \partial_{f_n} L(f + kF) + b_n L(f; f_n, \zeta_n)
+    + b_n' \partial_{f_n} L(f)\big].
+
+Each combination channel is tested against "noise only" (:math:`H_k = 0`)
+by the F-test of this linear fit, weighted by :math:`1/|\hat H_0|` (the
+noise of the correlation scales with the excitation-frequency response, as
+:func:`mutext.rig.measure_rotor` simulates it); the F-test needs no noise
+level, only that the noise be circular and proportional to
+:math:`|\hat H_0|`.  A channel is found when its p-value is below ``alpha``
+over the number of channels (Bonferroni).  With channels at several running
+speeds an order counts only when it is found at every speed measured: the
+crack's response moves with the speed as predicted (the shapes are placed at
+:math:`f_n - kF` for each speed's :math:`F`), a fixed-frequency artefact
+does not.  When combination channels are present their verdict is the
+evidence (``source = "combination"``); the stepped-sine sideband test is still
+run on the excitation-frequency channels and reported beside it.
 """
 from __future__ import annotations
 
@@ -49,7 +80,7 @@ from scipy import stats
 
 from ..errors import ModelError
 
-__all__ = ["SidebandCandidate", "SidebandEvidence", "sideband_evidence"]
+__all__ = ["SidebandCandidate", "CombinationTest", "SidebandEvidence", "sideband_evidence", "frf_order"]
 
 
 @dataclass
@@ -68,6 +99,38 @@ class SidebandCandidate:
 
     def to_dict(self) -> dict:
         return dict(self.__dict__)
+
+
+@dataclass
+class CombinationTest:
+    """The test of one combination-frequency channel (response at f + kF to excitation at f)."""
+    k: int
+    speed_hz: float
+    channel: str
+    f_stat: float = float("nan")
+    p_value: float = float("nan")
+    snr: float = float("nan")          # largest fitted response over the noise of the main channel
+    found: bool = False
+    consistent: bool = True            # found at every speed measured for this |k|
+
+    def to_dict(self) -> dict:
+        return dict(self.__dict__)
+
+
+def frf_order(frf) -> int:
+    """The combination order ``k`` of an FRF (its ``order`` metadata; 0 for an ordinary FRF)."""
+    v = frf.metadata.get("order") if isinstance(frf.metadata, dict) else None
+    if v is None:
+        return 0
+    try:
+        k = int(str(v).strip())
+    except ValueError:
+        raise ModelError(f"sideband_evidence: FRF metadata 'order' must be an integer k (response at "
+                         f"f + k F), got {v!r}") from None
+    if k != 0 and not (frf.speed_hz and frf.speed_hz > 0):
+        raise ModelError(f"sideband_evidence: a combination channel (order {k}) needs its running speed "
+                         f"(speed_hz), got {frf.speed_hz!r}")
+    return k
 
 
 @dataclass
@@ -102,6 +165,9 @@ class SidebandEvidence:
     orders_found: list = field(default_factory=list)
     verdict: str = "none"
     detectable: float = float("nan")
+    combination: list = field(default_factory=list)
+    source: str = "stepped sine"
+    stepped_sine_verdict: str = "none"
 
     def found(self) -> list:
         return [c for c in self.candidates if c.found and not c.unpaired]
@@ -120,7 +186,15 @@ class SidebandEvidence:
 
     def summary(self) -> str:
         lines = [f"sidebands at {self.speed_hz:g} Hz running speed (noise {100 * self.noise:.3g} %, "
-                 f"threshold p < {self.threshold:.2g}): {self.verdict}: {self.meaning()}"]
+                 f"threshold p < {self.threshold:.2g}, from the {self.source} channels): {self.verdict}: "
+                 f"{self.meaning()}"]
+        if self.combination:
+            lines.append(f"  combination-frequency channels (first order); stepped-sine sidebands alone: "
+                         f"{self.stepped_sine_verdict}")
+            for c in self.combination:
+                mark = ("FOUND" if c.consistent else "FOUND, not at every speed") if c.found else "-"
+                lines.append(f"  k={c.k:+d} at {c.speed_hz:g} Hz  {c.channel}  F {c.f_stat:9.2f}  "
+                             f"p {c.p_value:9.2e}  snr {c.snr:8.2f}  {mark}")
         for c in self.candidates:
             if c.masked:
                 continue
@@ -133,7 +207,9 @@ class SidebandEvidence:
         return {"speed_hz": self.speed_hz, "noise": self.noise, "threshold": self.threshold,
                 "verdict": self.verdict, "meaning": self.meaning(), "orders_found": list(self.orders_found),
                 "detectable": self.detectable, "modes": [list(m) for m in self.modes],
-                "candidates": [c.to_dict() for c in self.candidates]}
+                "candidates": [c.to_dict() for c in self.candidates], "source": self.source,
+                "stepped_sine_verdict": self.stepped_sine_verdict,
+                "combination": [c.to_dict() for c in self.combination]}
 
 
 def _shape(f, fn, zeta):
@@ -204,7 +280,13 @@ def sideband_evidence(frfs, natural_frequencies_hz, speed_hz: float, *, orders=(
     SidebandEvidence
     """
     from ..frfit import noise_level
-    data = _as_list(frfs)
+    everything = _as_list(frfs)
+    combos = [d for d in everything if frf_order(d) != 0]
+    mains = [d for d in everything if frf_order(d) == 0]
+    data = [d for d in mains if d.speed_hz is None or abs(d.speed_hz - speed_hz) <= 1e-9 * abs(speed_hz)]
+    if not data:
+        raise ModelError(f"sideband_evidence: no excitation-frequency FRF (without an 'order') at the running "
+                         f"speed {speed_hz!r} Hz; the mode frequencies and the noise are read from it")
     f = np.asarray(data[0].freq_hz, float)
     for d in data[1:]:
         if d.freq_hz.shape != f.shape or not np.allclose(d.freq_hz, f, rtol=1e-9, atol=0):
@@ -298,5 +380,67 @@ def sideband_evidence(frfs, natural_frequencies_hz, speed_hz: float, *, orders=(
                "twice per revolution" if 2 in found else "none")
     n_win = max(8, int(round(2 * 2.5 / df)))
     detectable = noise * float(np.sqrt(stats.chi2.isf(threshold, 2) / n_win)) * 2.0
-    return SidebandEvidence(cands, [(float(a), float(b)) for a, b in modes], F, noise, threshold, found,
-                            verdict, detectable)
+    ev = SidebandEvidence(cands, [(float(a), float(b)) for a, b in modes], F, noise, threshold, found,
+                          verdict, detectable, stepped_sine_verdict=verdict)
+    if combos:
+        ev.combination = _combination_tests(combos, mains, modes, noise, alpha)
+        ks = sorted({abs(c.k) for c in ev.combination if c.found and c.consistent})
+        ev.orders_found = ks
+        ev.verdict = ("once per revolution" if (1 in ks or 3 in ks) else
+                      "twice per revolution" if 2 in ks else "none")
+        ev.source = "combination"
+        ev.threshold = alpha / len(ev.combination)
+    return ev
+
+
+def _same_channel(a, b) -> bool:
+    return (a.input_station == b.input_station and a.output_station == b.output_station
+            and a.input_direction == b.input_direction and a.output_direction == b.output_direction)
+
+
+def _combination_tests(combos, mains, modes, noise, alpha) -> list:
+    """F-test of every combination channel against noise only (module docstring)."""
+    tests = []
+    for c in combos:
+        k, F = frf_order(c), float(c.speed_hz)
+        f = np.asarray(c.freq_hz, float)
+        y = np.asarray(c.response, complex)
+        ref = next((m for m in mains if _same_channel(m, c) and m.speed_hz is not None
+                    and abs(m.speed_hz - F) <= 1e-9 * F and m.freq_hz.shape == f.shape
+                    and np.allclose(m.freq_hz, f, rtol=1e-9, atol=0)), None)
+        wt = np.ones(f.size) if ref is None else 1.0 / np.maximum(np.abs(ref.response), 1e-300)
+        cols = [np.ones_like(f)]
+        for fn, zn in modes:
+            for fx in (f + k * F, f):
+                if f.min() - 3 * F <= fn <= f.max() + 3 * F or fx.min() <= fn <= fx.max():
+                    Dn = fn * fn - fx * fx + 2j * zn * fn * fx
+                    cols += [1.0 / Dn, (2 * fn + 2j * zn * fx) / Dn ** 2]
+        X = np.column_stack(cols) * wt[:, None]
+        yw = y * wt
+        p = X.shape[1]
+        name = f"{c.output_name or c.output_station}/{c.input_name or c.input_station}"
+        t = CombinationTest(k, F, name)
+        n = f.size
+        if n - p < 4:
+            raise ModelError(f"sideband_evidence: the combination channel {name} (order {k}) has {n} "
+                             f"frequencies, too few for its {p} shapes")
+        # a column scale that keeps the least-squares problem well conditioned
+        sc = np.linalg.norm(X, axis=0)
+        coef = np.linalg.lstsq(X / sc, yw, rcond=None)[0]
+        fit = (X / sc) @ coef
+        rss1 = float(np.sum(np.abs(yw - fit) ** 2))
+        rss0 = float(np.sum(np.abs(yw) ** 2))
+        t.f_stat = ((rss0 - rss1) / (2 * p)) / max(rss1 / (2 * (n - p)), 1e-300)
+        t.p_value = float(stats.f.sf(max(t.f_stat, 0.0), 2 * p, 2 * (n - p)))
+        sigma = np.sqrt(rss1 / (n - p))         # residual noise in weighted units
+        t.snr = float(np.max(np.abs(fit)) / max(sigma, 1e-300))
+        tests.append(t)
+    threshold = alpha / max(len(tests), 1)
+    for t in tests:
+        t.found = bool(t.p_value < threshold)
+    for t in tests:
+        same = [o for o in tests if abs(o.k) == abs(t.k)]
+        speeds = {o.speed_hz for o in same}
+        found_speeds = {o.speed_hz for o in same if o.found}
+        t.consistent = found_speeds == speeds
+    return tests
