@@ -12,8 +12,8 @@ with :math:`K_h` the rotor without the crack, :math:`A` the changes of the
 fully open crack (:meth:`mutext.rotor.crack.Crack.directional_deltas`) and
 :math:`g` the breathing law (:func:`mutext.rotor.crack.breathing_weights`).
 The stiffness is periodic with one revolution, :math:`K(t) = \sum_m K_m
-e^{jm\Omega t}` (orders up to 3 for the Mayes law, 2 for an always-open
-crack, all orders for the Gasch switch).
+e^{jm\Omega t}` (orders up to 3 for the Mayes law, 2 for the gaping
+notch, all orders for the Gasch switch).
 
 **Harmonic transfer functions.**  Forced at :math:`e^{j\omega t}`, the
 steady response is :math:`q(t) = \sum_k Q_k e^{j(\omega + k\Omega)t}` and
@@ -276,7 +276,7 @@ def periodic_rotor(model, *, inputs: Sequence[str] | None = None, outputs: Seque
                    speed: float | None = None, values=None) -> PeriodicRotor:
     """The time-periodic matrices of a :class:`~mutext.rotor.Rotor` with breathing cracks.
 
-    Cracks declared with ``breathing = "open" | "mayes" | "gasch"`` (in a model
+    Cracks declared with ``breathing = "gaping" | "mayes" | "gasch"`` (in a model
     file, or ``Crack(..., breathing=...)``) turn with the shaft; everything
     else is time-invariant.  A rotor without a breathing crack gives a
     time-invariant model, for which every function here returns the ordinary
