@@ -64,18 +64,29 @@ class _DGParams:
             self.El = np.eye(self.m)[S.col_block]
             self.Er = np.eye(self.m)[S.row_block]
 
-    #: set by the caller: value_grad then also keeps the first-order model of the top two
-    #: eigenvalues (diagonal scalings only) in ``cluster``
+    #: set by the caller: value_grad then also keeps what the first-order model of the top two
+    #: eigenvalues (diagonal scalings only, :meth:`model`) is built from in ``cluster``
     want_cluster = False
     cluster = None
+
+    def model(self, gap: float):
+        """(lambda_2/lambda_1, C) at the point last evaluated, C (:meth:`_cluster`) only if the
+        relative gap of the two is below ``gap``; None without that evaluation."""
+        if self.cluster is None:
+            return None
+        A, w, V, beta0, gs, x = self.cluster
+        if w.size < 2 or not w[-1] > 0:
+            return None
+        r = float(w[-2] / w[-1])
+        if not 1.0 - r < gap:
+            return r, None
+        return self._cluster(A, w, V, beta0, gs, x)
 
     def _cluster(self, A, w, V, beta0, gs, x):
         r"""First-order model of the two largest eigenvalues of H, divided by the largest:
         (w1/w0, C) with C[k] = Q^H (dH/dx_k) Q / w0 (2 x 2, all coordinates), Q the two top
         eigenvectors (largest first).  With ``A`` and ``Y = AQ - j G'^H Q``,
         :math:`Q^H\partial_kHQ = R_k^HY + Y^HR_k`, :math:`R_k = \partial_kA\,Q`."""
-        if w.size < 2 or not w[-1] > 0:
-            return None
         Q = V[:, :-3:-1]
         P = A @ Q
         Y = P.copy()
@@ -83,13 +94,13 @@ class _DGParams:
             Y[self.gcol] -= 1j * (beta0 * gs)[:, None] * Q[self.grow]
         AY = A.conj().T @ Y
         # R_k^H Y summed over the rows of block k: columns (col_block) and rows (row_block)
-        T = (np.einsum("ia,ib->iab", P.conj(), Y).reshape(P.shape[0], 4).T @ self.El
-             - np.einsum("ia,ib->iab", Q.conj(), AY).reshape(Q.shape[0], 4).T @ self.Er)
+        T = ((P.conj()[:, :, None] * Y[:, None, :]).reshape(P.shape[0], 4).T @ self.El
+             - (Q.conj()[:, :, None] * AY[:, None, :]).reshape(Q.shape[0], 4).T @ self.Er)
         T = T.T.reshape(self.m, 2, 2)
         C = np.empty((self.size, 2, 2), complex)
         C[:self.m] = T + T.conj().transpose(0, 2, 1)
         if gs is not None:
-            X = np.einsum("ja,jb->jab", Q[self.grow].conj(), P[self.gcol])
+            X = Q[self.grow].conj()[:, :, None] * P[self.gcol][:, None, :]
             C[self.m:] = (1j * beta0 * np.cosh(x[self.m:]))[:, None, None] * (X - X.conj().transpose(0, 2, 1))
         return float(w[-2] / w[-1]), C / w[-1]
 
@@ -162,7 +173,8 @@ class _DGParams:
             if not grad:
                 return lam, None
             if self.want_cluster:
-                self.cluster = self._cluster(A, w, V, beta0, gs if self.nreal else None, x)
+                # kept for the model of the top two eigenvalues, built only where they are close
+                self.cluster = (A, w, V, beta0, gs if self.nreal else None, x)
             a = A @ v
             g = np.empty(self.size)
             g[:m] = 2.0 * ((a.real ** 2 + a.imag ** 2) @ self.El - lam * ((v.real ** 2 + v.imag ** 2) @ self.Er))
@@ -491,8 +503,8 @@ def _upper_fast(M, S: BlockStructure, params: _DGParams, x0=None, B0=None, ftol:
     cluster = None
     if kinks and params.diag and S.nrows >= 2:
         def cluster():
-            cl = params.cluster
-            return None if cl is None else (cl[0], cl[1][free])
+            cl = params.model(_CLUSTER_GAP)
+            return cl if cl is None or cl[1] is None else (cl[0], cl[1][free])
     params.want_cluster, params.cluster = cluster is not None, None
     try:
         with np.errstate(over="ignore", invalid="ignore"):
