@@ -186,3 +186,28 @@ def test_combination_metadata_is_checked(modes, healthy):
     chans[1].speed_hz = None
     with pytest.raises(ModelError, match="speed_hz"):
         sideband_evidence(chans, modes, SPEED_HZ)
+
+
+def test_fixed_frequency_line_is_not_read_as_a_combination_response(modes, healthy):
+    # a 59.5 Hz line in the sensor, 30 x the noise, seen in the channel of order k where
+    # f + k F = 59.5 Hz (it moves with the speed on the excitation axis): not a resonance shape
+    # of the rotor at f + k F or f, so not evidence at either speed
+    chans = []
+    for F, seed in ((10.0, 1), (12.0, 2)):
+        c = combo(healthy, 0.01, seed, speed_hz=F)
+        for ch in c[1:]:
+            k = int(ch.metadata["order"])
+            near = np.abs(ch.freq_hz + k * F - 59.5) < 0.6
+            assert near.sum() >= 2
+            ch.response = ch.response + near * 30 * 0.01 * np.abs(c[0].response)
+        chans += c
+    ev = sideband_evidence(chans, modes, SPEED_HZ)
+    assert ev.verdict == "none" and len(ev.combination) == 4, ev.summary()
+    # a response shaped as the first mode at f + F (peak 30 % of the largest main response) is found:
+    # the test can fail
+    ch = chans[2]
+    fn = min(modes)
+    shape = 1.0 / (fn ** 2 - (ch.freq_hz + 10.0) ** 2 + 2j * 0.01 * fn * (ch.freq_hz + 10.0))
+    ch.response = ch.response + shape * (0.3 * np.max(np.abs(chans[0].response)) / np.max(np.abs(shape)))
+    ev = sideband_evidence(chans[:3], modes, SPEED_HZ)
+    assert ev.verdict == "once per revolution", ev.summary()
