@@ -4,7 +4,11 @@ Builds the healthy and the cracked rotor from the thesis station tables with
 the bearings, exciter and damping of ``mutext/data/rotor.toml``, prints the
 natural frequencies (Hz) at the sweep speed (10 Hz rotation) and the
 frequency response from the exciter current (station 12, A) to the exciter
-sensor (station 13, m) over the measured band 20-225 Hz.
+sensor (station 13, m) over the measured band 20-225 Hz, the healthy rotor's
+Campbell diagram (0-6000 rpm: the mode frequencies and the 1x forward critical
+speeds, :func:`mutext.rotor.campbell`) and the orbit at the sensor station
+for an unbalance at the crack station at the sweep speed
+(:func:`mutext.rotor.unbalance_response`, :func:`mutext.rotor.orbit`).
 
 The "cracked" model is the thesis's hand-tuned cracked table (density and
 disk mass changed); it contains no crack element.
@@ -21,6 +25,10 @@ CRACKED_NOTE = ("'cracked' is the thesis's hand-tuned cracked station table (den
                 "5.21 lb); it has no crack element")
 ASSUMED = ("ASSUMED (not in the thesis): bearing stiffness 1e7 N/m at stations 2 and 29, exciter 40 N/A, "
            "Poisson's ratio 0.3, 1 % modal damping")
+
+
+#: Unbalance of the orbit: 10 g mm at the crack station, seen by the sensor station.
+UNBALANCE = {"station": 15, "kg_m": 1e-5, "probe": 13}
 
 
 def add_arguments(p):
@@ -64,6 +72,20 @@ def solve(model_path=None, *, n_modes=6, points=400, band=(20.0, 225.0)):
         out["frf_peaks_hz"][key] = [float(x) for x in pk]
         out["frf_antiresonances_hz"][key] = [float(x) for x in an]
     r = rotors["healthy"]
+    from ..rotor.campbell_diagram import campbell
+    from ..rotor.orbits import orbit
+    from ..rotor.unbalance import unbalance_response
+    rpm = np.linspace(0.0, 6000.0, 13)
+    cd = campbell(r, rpm * np.pi / 30.0, n_modes=4, orders=(1,))
+    out["campbell"] = {"speeds_rpm": [float(x) for x in rpm],
+                       "frequencies_hz": [[float(x) for x in row] for row in cd.frequencies_hz],
+                       "critical_speeds_1x_forward": [c.to_dict() for c in cd.critical_speeds(1, "forward")]}
+    ub = UNBALANCE
+    u = unbalance_response(r, ub["station"], ub["kg_m"], [r.speed], [ub["probe"]])
+    orb = orbit({1: (complex(u.X[0, 0]), complex(u.Y[0, 0]))}, r.speed, label=f"station {ub['probe']}")
+    e = orb.ellipse(1)
+    out["orbit"] = {**ub, "speed_rpm": r.speed * 30.0 / np.pi, "semi_major_m": float(e.semi_major),
+                    "semi_minor_m": float(e.semi_minor), "direction": e.direction}
     out["speed_rpm"] = r.speed * 60.0 / (2.0 * np.pi)
     out["bearing_stiffness_n_per_m"] = r.parameter("bearing2.k").value
     out["force_per_ampere_n_per_a"] = r.parameter("exciter12.ki").value
@@ -81,7 +103,8 @@ def run(args) -> int:
     if args.json:
         from ..jsonio import print_json
         keys = ("natural_frequencies_hz", "whirl", "frf_peaks_hz", "frf_antiresonances_hz", "speed_rpm",
-                "bearing_stiffness_n_per_m", "force_per_ampere_n_per_a", "note", "assumptions", "seconds")
+                "bearing_stiffness_n_per_m", "force_per_ampere_n_per_a", "campbell", "orbit", "note",
+                "assumptions", "seconds")
         print_json({k: out[k] for k in keys})
     else:
         r = out["rotors"]["healthy"]
@@ -102,6 +125,16 @@ def run(args) -> int:
                   + ", ".join(f"{x:.1f}" for x in out["frf_peaks_hz"][key]) + " Hz; anti-resonances at "
                   + ", ".join(f"{x:.1f}" for x in out["frf_antiresonances_hz"][key])
                   + f" Hz; max |H| = {abs(H[k]) * 1e6:.3g} um/A at {out['freqs_hz'][k]:.1f} Hz")
+        cb = out["campbell"]
+        print("Campbell (healthy) [Hz] at " + ", ".join(f"{x:.0f}" for x in cb["speeds_rpm"][::4]) + " rpm: "
+              + "; ".join(", ".join(f"{x:.1f}" for x in row) for row in cb["frequencies_hz"][::4]))
+        crit = cb["critical_speeds_1x_forward"]
+        print("1x forward critical speeds (0-6000 rpm): " + (", ".join(
+            f"{c['speed_rpm']:.0f} rpm ({c['frequency_hz']:.1f} Hz)" for c in crit) or "none"))
+        o = out["orbit"]
+        print(f"orbit at station {o['probe']} ({o['kg_m'] * 1e6:g} g mm unbalance at station {o['station']}, "
+              f"{o['speed_rpm']:.0f} rpm): ellipse {o['semi_major_m'] * 1e6:.3g} x {o['semi_minor_m'] * 1e6:.3g} um, "
+              f"{o['direction']}")
         print(f"time: {out['seconds']:.2f} s")
     if args.plots:
         files = save_plots(out, args.plots)

@@ -1,0 +1,27 @@
+"""`mutext demo rotor`: the Campbell diagram and the unbalance orbit it prints, checked apart."""
+import json
+
+import numpy as np
+import pytest
+
+from mutext.cli import main
+
+
+@pytest.mark.slow
+def test_demo_rotor_campbell_and_orbit(capsys):
+    assert main(["demo", "rotor", "--json", "--points", "50"]) == 0
+    out = json.loads(capsys.readouterr().out)
+    cb, orb = out["campbell"], out["orbit"]
+    # the 1x forward critical speed lies where 1x meets the first forward mode: rpm = 60 f
+    crit = cb["critical_speeds_1x_forward"]
+    assert len(crit) == 1
+    assert crit[0]["speed_rpm"] == pytest.approx(60.0 * crit[0]["frequency_hz"], rel=1e-3)
+    assert crit[0]["frequency_hz"] == pytest.approx(out["natural_frequencies_hz"]["healthy"][1], rel=0.01)
+    # orbit: isotropic bearings give a forward circle of radius |H(F15 -> x13)| U Omega^2
+    from mutext.rotor import data_path, load_model
+    r = load_model(data_path("rotor.toml"))
+    w = r.speed
+    H = r.frf([w / (2 * np.pi)], inputs=["F15"], outputs=["x13"]).H[0, 0, 0]
+    assert orb["direction"] == "forward"
+    assert orb["semi_minor_m"] == pytest.approx(orb["semi_major_m"], rel=1e-6)
+    assert orb["semi_major_m"] == pytest.approx(abs(H) * orb["kg_m"] * w ** 2, rel=0.02)
