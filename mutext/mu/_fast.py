@@ -551,7 +551,7 @@ def _fast_polish(M, S: BlockStructure, params: _DGParams, x0=None):
 
 
 #: default bound (``mu_upper(method="auto")``): tolerance of the descent on log lambda_max
-_AUTO_FTOL = 1e-11
+_AUTO_FTOL = 1e-9
 
 
 def _fast_default(M, S: BlockStructure, params: _DGParams, always: bool = False):
