@@ -7,6 +7,7 @@ congruent form, in coordinates that carry over from one frequency to the next
 from __future__ import annotations
 
 import numpy as np
+from scipy.linalg.lapack import dsyev as _dsyev
 from scipy.linalg.lapack import zheevd as _zheevd
 
 from ._certificate import MuUpper, _d_from_matrices, _diag_result
@@ -294,10 +295,12 @@ def _cluster_step(cl, B):
     Q3 = J @ BJ
     Q3 = 0.5 * (Q3 + Q3.T)
     b = r0 - BJ.T @ gc
-    q, V = np.linalg.eigh(Q3)
+    q, V, info = _dsyev(Q3)
+    if info != 0:
+        q, V = np.linalg.eigh(Q3)
     bb = V.T @ b
     top = float(q[-1])
-    nb = float(np.linalg.norm(b))
+    nb = float(np.sqrt(b @ b))
     if not top > 1e-14 * nb:
         # the model's curvature vanishes (or is negligible): the linear part alone
         u = b / nb if nb > 0 else np.zeros(3)
@@ -522,10 +525,12 @@ def _upper_fast(M, S: BlockStructure, params: _DGParams, x0=None, B0=None, ftol:
 
 def _fast_at(M, S: BlockStructure, params: _DGParams, x0=None, B0=None, ftol: float = 1e-10,
              max_eval: int = 400, info: dict | None = None, osborne_tol: float = 0.0,
-             kinks: bool = False):
+             kinks: bool = False, nrm: float | None = None):
     """:func:`_upper_fast` with the shortcuts of :func:`mu_upper` (one full block, ``M = 0``,
-    extreme norms); returns (MuUpper, coordinates or None, inverse Hessian or None)."""
-    nrm = _norm2(M)
+    extreme norms); returns (MuUpper, coordinates or None, inverse Hessian or None).
+    ``nrm``: sigma_max(M) if already known."""
+    if nrm is None:
+        nrm = _norm2(M)
     if nrm == 0 or (len(S) == 1 and S.blocks[0].kind == "full"):
         return _diag_result(M, S, np.ones(len(S)), "sigma"), None, None
     if not 1e-100 <= nrm <= 1e100:
@@ -554,14 +559,17 @@ def _fast_polish(M, S: BlockStructure, params: _DGParams, x0=None):
 _AUTO_FTOL = 1e-9
 
 
-def _fast_default(M, S: BlockStructure, params: _DGParams, always: bool = False):
+def _fast_default(M, S: BlockStructure, params: _DGParams, always: bool = False, nrm: float | None = None):
     """The fast bound as the default of :func:`mu_upper`: one descent from Osborne balancing,
     restarted from the point reached (fresh Hessian approximation) only while the line search
     stalls at a kink of lambda_max and the restart still lowers the bound.
-    Returns (MuUpper with the evaluations of all descents, coordinates or None)."""
+    Returns (MuUpper with the evaluations of all descents, coordinates or None).
+    ``nrm``: sigma_max(M) if already known."""
     info = {}
+    if nrm is None:
+        nrm = _norm2(M)
     up, x, _ = _fast_at(M, S, params, None, None, ftol=_AUTO_FTOL, max_eval=300, info=info,
-                        osborne_tol=1e-2, kinks=True)
+                        osborne_tol=1e-2, kinks=True, nrm=nrm)
     nev = up.iterations
     for _ in range(_FAST_RESTARTS):
         if x is None or (info.get("stop") == "ftol" and not always):
@@ -570,7 +578,8 @@ def _fast_default(M, S: BlockStructure, params: _DGParams, always: bool = False)
             # no step taken from x with a fresh Hessian approximation: a restart from x
             # would repeat the same failed line search
             break
-        up2, x2, _ = _fast_at(M, S, params, x, None, ftol=_AUTO_FTOL, max_eval=200, info=info, kinks=True)
+        up2, x2, _ = _fast_at(M, S, params, x, None, ftol=_AUTO_FTOL, max_eval=200, info=info, kinks=True,
+                              nrm=nrm)
         nev += up2.iterations
         if not up2.value < up.value * (1 - 1e-10):
             break

@@ -6,6 +6,8 @@ scalings of the LMI and fast bounds).
 """
 from __future__ import annotations
 
+import math
+
 import numpy as np
 
 from ._structure import BlockStructure
@@ -23,28 +25,35 @@ def _osborne(M, S: BlockStructure, iterations: int = 30, tol: float = 0.0) -> np
     m = len(S)
     if m == 1:
         return np.zeros(1)
-    B = np.array([[np.linalg.norm(M[S.col_slices[i], S.row_slices[j]], "fro") for j in range(m)]
-                  for i in range(m)])
-    np.fill_diagonal(B, 0.0)
-    if B.max() == 0:
+    # squared Frobenius norms of the blocks M_ij (rows of block i's outputs, columns of block j's inputs)
+    A2 = M.real ** 2 + M.imag ** 2 if np.iscomplexobj(M) else np.asarray(M, float) ** 2
+    B2 = np.eye(m)[S.col_block].T @ A2 @ np.eye(m)[S.row_block]
+    np.fill_diagonal(B2, 0.0)
+    top = B2.max()
+    if top == 0:
         return np.zeros(m)
-    B = B / B.max()
-    B = np.maximum(B, 1e-14)
-    np.fill_diagonal(B, 0.0)
-    x = np.zeros(m)
-    B2 = B * B
+    B2 = np.maximum(B2 / top, 1e-28)             # the block norms floored at 1e-14 of the largest
+    np.fill_diagonal(B2, 0.0)
+    # the sweeps on Python floats: m is small and the loop is sequential (Gauss-Seidel)
+    b2 = B2.tolist()
+    x = [0.0] * m
+    e2 = [1.0] * m
+    inv = [1.0] * m
+    rng = range(m)
     for _ in range(iterations):
         moved = 0.0
-        for i in range(m):
-            e2 = np.exp(2.0 * x)
-            r2 = B2[i, :] @ (1.0 / e2)                   # row i of D B D^-1, squared, without d_i
-            c2 = B2[:, i] @ e2                           # column i, without 1/d_i
-            xi = min(max(0.25 * (np.log(c2) - np.log(r2)), -30.0), 30.0)
+        for i in rng:
+            row = b2[i]
+            r2 = sum(row[j] * inv[j] for j in rng)       # row i of D B D^-1, squared, without d_i
+            c2 = sum(b2[j][i] * e2[j] for j in rng)      # column i, without 1/d_i
+            xi = min(max(0.25 * (math.log(c2) - math.log(r2)), -30.0), 30.0)
             moved = max(moved, abs(xi - x[i]))
             x[i] = xi
+            e2[i] = math.exp(2.0 * xi)
+            inv[i] = 1.0 / e2[i]
         if moved <= tol:
             break
-    return x - x[-1]
+    return np.array(x) - x[-1]
 
 
 def _sigma_and_grad(M, S, x):

@@ -75,13 +75,13 @@ def _certify(M, S: BlockStructure, up: MuUpper) -> MuUpper | None:
     return up
 
 
-def _upper_auto(M, S: BlockStructure, use_g: bool, lower, rtol: float) -> MuUpper:
+def _upper_auto(M, S: BlockStructure, use_g: bool, lower, rtol: float, nrm: float | None = None) -> MuUpper:
     """The default bound: the fast D-G descent, certified by its scalings; the LMI where the
     certificate does not reproduce the value, the descent failed, or the structure has
     repeated real scalars (then started from the fast scalings, so one solve confirms them)."""
     up = None
     try:
-        up, _ = _fast_default(M, S, _params(S, use_g))
+        up, _ = _fast_default(M, S, _params(S, use_g), nrm=nrm)
         up = _certify(M, S, up)
     except (np.linalg.LinAlgError, ValueError, FloatingPointError):
         up = None
@@ -200,7 +200,7 @@ def mu_upper(M, structure: BlockStructure, *, method: str = "auto", real: str = 
     if method == "fast":
         return _fast_polish(M, S, _DGParams(S, use_g))[0]
     if method == "auto":
-        return _upper_auto(M, S, use_g, lower, rtol)
+        return _upper_auto(M, S, use_g, lower, rtol, nrm)
     # Balance first: the LMI is posed for M0 = L0 M R0^-1 with the best diagonal
     # scaling (Osborne + ellipsoid).  Its remaining scalings are then close to I,
     # which keeps the solver accurate when M is badly scaled (the optimal d
