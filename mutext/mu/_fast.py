@@ -274,6 +274,9 @@ class _DGParams:
 #: relative gap of the two largest eigenvalues below which the descent steps on their
 #: first-order model (the kink of lambda_max) instead of the gradient of the largest
 _CLUSTER_GAP = 0.05
+#: "stall": the model step only once a line search along the BFGS direction failed or needed
+#: more than 3 trials (a kink); "always": wherever the gap is below _CLUSTER_GAP
+_CLUSTER_MODE = "stall"
 
 
 def _cluster_step(cl, B):
@@ -359,13 +362,15 @@ def _bfgs(fun, x0, B0=None, max_iter: int = 100, ftol: float = 1e-10, max_step: 
     small = 0
     stop = "budget"
     moved = False
+    kinked = _CLUSTER_MODE == "always"
+    cl_fail = False         # the model step failed at the current point
     for _ in range(max_iter):
         if nev >= max_eval:
             break
         if not np.abs(g).max(initial=0.0) > 1e-13:
             stop = "ftol"           # a smooth stationary point (no line search can go down)
             break
-        if cl is not None and 1.0 - cl[0] < _CLUSTER_GAP:
+        if kinked and not cl_fail and cl is not None and 1.0 - cl[0] < _CLUSTER_GAP:
             d, pred = _cluster_step(cl, B)
             if pred < 0 and np.all(np.isfinite(d)):
                 big = np.abs(d).max()
@@ -379,6 +384,7 @@ def _bfgs(fun, x0, B0=None, max_iter: int = 100, ftol: float = 1e-10, max_step: 
                     t *= 0.5
                 else:
                     ft = np.inf
+                    cl_fail = True
                 if ft < np.inf:
                     s_, y_ = t * d, gt - g
                     drop = f - ft
@@ -423,6 +429,8 @@ def _bfgs(fun, x0, B0=None, max_iter: int = 100, ftol: float = 1e-10, max_step: 
                 ok = True
                 break
             t = 0.5 * (lo + hi) if np.isfinite(hi) else 2.0 * lo
+        if _ls >= 3:
+            kinked = True
         if not ok:
             if ft < f:          # a decrease without the curvature condition: keep it
                 x, f = xt, ft
@@ -430,6 +438,9 @@ def _bfgs(fun, x0, B0=None, max_iter: int = 100, ftol: float = 1e-10, max_step: 
                 nev += 1
                 moved = True
                 cl = cluster() if cluster is not None else None
+                cl_fail = False
+            if not cl_fail and cl is not None and 1.0 - cl[0] < _CLUSTER_GAP:
+                continue        # at a kink: the model step next
             if reset:
                 stop = "stall"
                 break
@@ -442,6 +453,7 @@ def _bfgs(fun, x0, B0=None, max_iter: int = 100, ftol: float = 1e-10, max_step: 
         moved = True
         x, f, g = xt, ft, gt
         cl = cluster() if cluster is not None else None
+        cl_fail = False
         sy = float(s @ y)
         if sy > 1e-14 * float(s @ s):
             By = B @ y
