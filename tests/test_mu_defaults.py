@@ -138,3 +138,25 @@ def test_default_sweep_peak_equals_ab13md(plant):
     # the LMI route's peak, from scratch at the same frequency, agrees
     lmi = mu_upper(Mp, S, method="lmi")
     assert lmi.value == pytest.approx(sw.peak_upper, rel=1e-5)
+
+
+@pytest.mark.parametrize("seed", range(12))
+def test_default_equals_ab13md_random_structures(seed):
+    # structures of 1-4 blocks as drawn by benchmarks/bench_mu.py, restricted to those AB13MD
+    # takes: single blocks (mu = sigma_max or |m|), two 1 x 1 blocks (balanced from the start),
+    # real blocks with real and complex M
+    ab13md = pytest.importorskip("slycot").ab13md
+    rng = np.random.default_rng(2000 + seed)
+    kinds = list(rng.choice(["real", "c1", "full2"], size=int(rng.integers(1, 5)), p=[0.3, 0.45, 0.25]))
+    if seed < 3:
+        kinds = [["c1"], ["c1", "c1"], ["real", "c1"]][seed]
+    S, nb, it = ab13md_structure(kinds)
+    for variant in range(2):
+        M = _matrix(rng, S, variant)
+        up = mu_upper(M, S)
+        ref = ab13md(M, nb, it)[0]
+        _certified(M, S, up)
+        assert up.value <= ref * (1 + 1e-6) + 1e-12
+        if up.value < ref * (1 - 1e-6):
+            lmi = mu_upper(M, S, method="lmi")
+            assert up.value == pytest.approx(lmi.value, rel=1e-5)
