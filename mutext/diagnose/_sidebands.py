@@ -283,10 +283,13 @@ def sideband_evidence(frfs, natural_frequencies_hz, speed_hz: float, *, orders=(
     everything = _as_list(frfs)
     combos = [d for d in everything if frf_order(d) != 0]
     mains = [d for d in everything if frf_order(d) == 0]
-    data = [d for d in mains if d.speed_hz is None or abs(d.speed_hz - speed_hz) <= 1e-9 * abs(speed_hz)]
-    if not data:
-        raise ModelError(f"sideband_evidence: no excitation-frequency FRF (without an 'order') at the running "
-                         f"speed {speed_hz!r} Hz; the mode frequencies and the noise are read from it")
+    if not mains:
+        raise ModelError(f"sideband_evidence: no excitation-frequency FRF (without an 'order') among the "
+                         f"{len(everything)} given; the mode frequencies and the noise are read from it")
+    # with channels at several speeds, the stepped-sine test uses those at speed_hz
+    numeric = isinstance(speed_hz, (int, float, np.integer, np.floating)) and not isinstance(speed_hz, bool)
+    data = [d for d in mains if numeric and (d.speed_hz is None
+                                             or abs(d.speed_hz - speed_hz) <= 1e-9 * abs(speed_hz))] or mains
     f = np.asarray(data[0].freq_hz, float)
     for d in data[1:]:
         if d.freq_hz.shape != f.shape or not np.allclose(d.freq_hz, f, rtol=1e-9, atol=0):
