@@ -6,6 +6,8 @@ congruent form, in coordinates that carry over from one frequency to the next
 """
 from __future__ import annotations
 
+import math
+
 import numpy as np
 from scipy.linalg.lapack import dsyev as _dsyev
 from scipy.linalg.lapack import zheevd as _zheevd
@@ -277,6 +279,9 @@ _CLUSTER_GAP = 0.05
 #: "stall": the model step only once a line search along the BFGS direction failed or needed
 #: more than 3 trials (a kink); "always": wherever the gap is below _CLUSTER_GAP
 _CLUSTER_MODE = "stall"
+#: the descent also stops when a step gained less than ftol and the next BFGS step is predicted
+#: (-g'p, twice the quadratic model's decrease) to gain less than _PRED_STOP * ftol
+_PRED_STOP = 1.0
 
 
 def _cluster_step(cl, B):
@@ -404,6 +409,9 @@ def _bfgs(fun, x0, B0=None, max_iter: int = 100, ftol: float = 1e-10, max_step: 
                     continue
         p = -B @ g
         gp = float(g @ p)
+        if small and -gp < _PRED_STOP * ftol:
+            stop = "ftol"           # the last step gained < ftol and the next is predicted to gain less
+            break
         if not gp < 0:
             B = np.eye(n)
             p = -g
@@ -495,26 +503,29 @@ def _upper_fast(M, S: BlockStructure, params: _DGParams, x0=None, B0=None, ftol:
         for gs in params.gslots:
             if gs is not None:
                 x0[gs] = np.clip(x0[gs], -_G_CLIP, _G_CLIP)
-    beta0 = np.sqrt(max(params.value_grad(x0, M, 1.0, grad=False)[0], 0.0))
-    if params.use_g and beta0 == 0:
-        beta0 = 1.0
+    if params.use_g:
+        beta0 = np.sqrt(max(params.value_grad(x0, M, 1.0, grad=False)[0], 0.0))
+        if beta0 == 0:
+            beta0 = 1.0
+    else:
+        beta0 = 1.0         # no G: beta0 does not enter
     # the first G-free sigma_max: with a warm start G carries over (it is scaled by beta0)
     free = params.free
 
     def fun(y):
+        if y.size and (y.max() > 200.0 or y.min() < -200.0):
+            return np.inf, np.zeros(free.size)     # a line-search trial far out: reject it
         x = x0.copy()
         x[free] = y
-        if np.abs(y).max(initial=0.0) > 200.0:
-            return np.inf, np.zeros(free.size)     # a line-search trial far out: reject it
         try:
             lam, g = params.value_grad(x, M, beta0)
         except (np.linalg.LinAlgError, ValueError):
             return np.inf, np.zeros(free.size)
-        if not np.isfinite(lam):
+        if not math.isfinite(lam):
             return np.inf, np.zeros(free.size)
         if not lam > 0:
             return -np.inf, np.zeros(free.size)
-        return np.log(lam), g[free]
+        return math.log(lam), g[free]
     cluster = None
     if kinks and params.diag and S.nrows >= 2:
         def cluster():
