@@ -10,7 +10,7 @@ _limits = threadpool_limits(limits=1, user_api="blas")
 
 
 # ---------------------------------------------------------------------------
-# parallel runs (pytest-xdist; pyproject's addopts: -n auto --dist loadgroup)
+# parallel runs (pytest-xdist; pyproject's addopts: -n auto --dist loadfile)
 # ---------------------------------------------------------------------------
 
 import os  # noqa: E402
@@ -46,14 +46,18 @@ def pytest_xdist_auto_num_workers(config):
     return 0 if n == 1 else n
 
 
-@pytest.hookimpl(tryfirst=True)
-def pytest_collection_modifyitems(config, items):
-    """Scheduling unit of ``--dist loadgroup``: a test module (its module-scoped fixtures are built
-    once, its tests never race each other), all grading modules together (see ``_GRADING``), or the
-    group a test names itself with ``@pytest.mark.xdist_group``."""
-    for item in items:
-        if item.get_closest_marker("xdist_group") is not None:
-            continue
-        module = item.nodeid.split("::", 1)[0]
-        name = "grading" if os.path.basename(module).startswith(_GRADING) else module
-        item.add_marker(pytest.mark.xdist_group(name))
+@pytest.hookimpl(optionalhook=True)
+def pytest_xdist_make_scheduler(config, log):
+    """``--dist loadfile`` with one change: all grading modules (see ``_GRADING``) are one unit, run
+    by one worker.  A module stays one unit (its module-scoped fixtures are built once, its tests
+    never race each other)."""
+    if config.getvalue("dist") != "loadfile":
+        return None
+    from xdist.scheduler import LoadFileScheduling
+
+    class _Scheduling(LoadFileScheduling):
+        def _split_scope(self, nodeid):
+            module = super()._split_scope(nodeid)
+            return "grading" if os.path.basename(module).startswith(_GRADING) else module
+
+    return _Scheduling(config, log)
