@@ -495,18 +495,20 @@ def _select_more(effects, hyps, rec, fit, held, s2, N, threshold, alpha, ref, no
         # scale and a sensor's gain can tie on the fitted data and part on the held-out data)
         tried = []
         for r, _, h, t in cands[:4]:
-            th, rss_new, sd = joint_fit(rec, fit, base + [h], thetas + [t], s2)
+            hs = base + [h]
+            th, rss_new, sd = joint_fit(rec, fit, hs, thetas + [t], s2)
+            hs, th, rss_new, sd = _nested_at_bound(hs, th, rss_new, sd, hyps, rec, fit, s2, notes)
             dchi = (rss_a - rss_new) / s2
-            held_new = _rss_of(Compound(rec, held, base + [h]).responses(th), held.meas)
+            held_new = _rss_of(Compound(rec, held, hs).responses(th), held.meas)
             dheld = (held_a - held_new) / s2
-            stuck = [x.description for x, tt in zip(base + [h], th) if at_bound(x, tt)]
-            left = max(1.0, rss_new / (s2 * max(N - sum(x.n_params for x in base + [h]), 1)))
+            stuck = [x.description for x, tt in zip(hs, th) if at_bound(x, tt)]
+            left = max(1.0, rss_new / (s2 * max(N - sum(x.n_params for x in hs), 1)))
             # an effect on one fitted file only (its scale) cannot show on other files: not held against them
             own_file_only = held_new == held_a and h.kind == "channel_scale"
             ok = dchi / left > threshold and (dheld > chi_held or own_file_only) and not stuck
-            tried.append((not ok, rss_new, h, th, sd, dchi, dheld, stuck, left))
+            tried.append((not ok, rss_new, h, th, sd, dchi, dheld, stuck, left, hs))
         tried.sort(key=lambda x: (x[0], x[1]))
-        failed, rss_new, h, th, sd, dchi, dheld, stuck, left = tried[0]
+        failed, rss_new, h, th, sd, dchi, dheld, stuck, left, hs = tried[0]
         if failed:
             why = ("a size at the bound of its range: " + ", ".join(stuck)) if stuck else (
                 f"delta chi2 {dchi:.1f} on the fitted data (threshold {threshold:.1f}"
@@ -516,8 +518,8 @@ def _select_more(effects, hyps, rec, fit, held, s2, N, threshold, alpha, ref, no
                          f"{len(effects)} effect(s): {why}")
             break
         new = []
-        n_par = sum(x.n_params for x in base + [h])
-        for k, (x, t, d) in enumerate(zip(base + [h], th, sd)):
+        n_par = sum(x.n_params for x in hs)
+        for k, (x, t, d) in enumerate(zip(hs, th, sd)):
             old = effects[k] if k < len(effects) else None
             vec = np.ndim(t) > 0
             t0, d0 = (float(t[0]), float(d[0])) if vec else (float(t), float(d))
@@ -535,6 +537,26 @@ def _select_more(effects, hyps, rec, fit, held, s2, N, threshold, alpha, ref, no
             effects = simpler
             quality = quality_of(effects, [e.theta for e in effects])
     return effects, quality
+
+
+def _nested_at_bound(hs, th, rss, sd, hyps, rec, fit, s2, notes):
+    """A k-parameter effect that a joint fit drives to a bound of a parameter (an absorber's spring to its
+    stiffest: a mass) replaced by its nested one-parameter reading (``Hypothesis.nested``), refitted jointly.
+    Returns ``(hypotheses, sizes, rss, stds)``, unchanged when there is nothing to replace."""
+    for j, x in enumerate(hs):
+        if not (x.params and x.nested and at_bound(x, th[j])):
+            continue
+        g = next((y for y in hyps if (y.kind, y.element) == x.nested[0]), None)
+        if g is None or any(g is y for y in hs):
+            continue
+        rest, rest_th = hs[:j] + hs[j + 1:], th[:j] + th[j + 1:]
+        t0, _ = fit_one_given(rec, fit, rest, rest_th, g)
+        hs2 = hs[:j] + [g] + hs[j + 1:]
+        th2, rss2, sd2 = joint_fit(rec, fit, hs2, th[:j] + [t0] + th[j + 1:], s2)
+        notes.append(f"{x.description} reached the bound of a parameter given the other effects: read as "
+                     f"{g.description} (its limit) and refitted")
+        return hs2, th2, rss2, sd2
+    return hs, th, rss, sd
 
 
 def _simplify(effects, hyps, rec, fit, s2, N, threshold, notes):
