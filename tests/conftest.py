@@ -17,10 +17,11 @@ import os  # noqa: E402
 
 import pytest  # noqa: E402
 
-# modules whose tests run confined grading children (as root: tmpfs, mount namespaces, the
-# unprivileged user) and check afterwards that /tmp, /var/tmp, /dev/shm and the shared memory are as
-# they found them: one worker runs them all, so no other grading child is alive during those checks
-_GRADING = ("test_grading", "test_gradescope")
+# modules whose tests grade hostile submissions (litter in /tmp, /var/tmp, /dev/shm, shared memory, as
+# root the unprivileged user) or check afterwards that those places are as they found them: one worker
+# runs them all, so none of their children is alive during another's checks
+_GRADING = ("test_grading_batch.py", "test_grading_hostile.py", "test_grading_reports.py",
+            "test_grading_resources.py", "test_gradescope.py")
 
 
 def _cpus() -> int:
@@ -48,8 +49,8 @@ def pytest_xdist_auto_num_workers(config):
 
 @pytest.hookimpl(optionalhook=True)
 def pytest_xdist_make_scheduler(config, log):
-    """``--dist loadfile`` with one change: all grading modules (see ``_GRADING``) are one unit, run
-    by one worker.  A module stays one unit (its module-scoped fixtures are built once, its tests
+    """``--dist loadfile`` with one change: the grading modules of ``_GRADING`` are one unit, run by
+    one worker.  A module stays one unit (its module-scoped fixtures are built once, its tests
     never race each other)."""
     if config.getvalue("dist") != "loadfile":
         return None
@@ -58,6 +59,6 @@ def pytest_xdist_make_scheduler(config, log):
     class _Scheduling(LoadFileScheduling):
         def _split_scope(self, nodeid):
             module = super()._split_scope(nodeid)
-            return "grading" if os.path.basename(module).startswith(_GRADING) else module
+            return "grading" if os.path.basename(module) in _GRADING else module
 
     return _Scheduling(config, log)
