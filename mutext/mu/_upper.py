@@ -181,7 +181,9 @@ def mu_upper(M, structure: BlockStructure, *, method: str = "auto", real: str = 
     if not (np.isfinite(rtol) and 0 < rtol < 1):
         raise ModelError(f"rtol must lie in (0, 1), got {rtol}")
     S = structure
-    nrm = _norm2(M)
+    # the size of M for the range check and the rescaling (mu is homogeneous): the largest
+    # entry, within a factor sqrt(size) of sigma_max and without an SVD
+    nrm = float(np.abs(M).max())
     if nrm != 0 and not 1e-100 <= nrm <= 1e100:
         # mu is homogeneous: bound mu(M / nrm) and scale back (entries near 1e+-150
         # overflow or underflow in the Gram matrices of the bound)
