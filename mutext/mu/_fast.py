@@ -580,6 +580,8 @@ def _fast_polish(M, S: BlockStructure, params: _DGParams, x0=None):
 
 #: default bound (``mu_upper(method="auto")``): tolerance of the descent on log lambda_max
 _AUTO_FTOL = 1e-9
+#: evaluations of each restart of the default bound's descent
+_RESTART_EVALS = 50
 
 
 def _fast_default(M, S: BlockStructure, params: _DGParams, always: bool = False, nrm: float | None = None):
@@ -601,7 +603,7 @@ def _fast_default(M, S: BlockStructure, params: _DGParams, always: bool = False,
             # no step taken from x with a fresh Hessian approximation: a restart from x
             # would repeat the same failed line search
             break
-        up2, x2, _ = _fast_at(M, S, params, x, None, ftol=_AUTO_FTOL, max_eval=200, info=info, kinks=True,
+        up2, x2, _ = _fast_at(M, S, params, x, None, ftol=_AUTO_FTOL, max_eval=_RESTART_EVALS, info=info, kinks=True,
                               nrm=nrm)
         nev += up2.iterations
         if not up2.value < up.value * (1 - 1e-10):
