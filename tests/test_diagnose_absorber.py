@@ -85,6 +85,7 @@ def test_a_loss_shared_by_every_spring_is_found_as_a_distributed_change(tmp_path
     assert float(np.sqrt(np.mean(np.concatenate(errs) ** 2))) < 0.3 * NOISE
 
 
+@pytest.mark.slow
 def test_a_grounded_spring_on_a_pedestal_is_found_sized_and_written(tmp_path):
     """The three-mass rig's spring k3 (m3 to ground) set on a pedestal (mass m_p, spring k_p to ground),
     built with the independent generator's matrices: an added DOF, k3 moved onto it."""
