@@ -529,7 +529,8 @@ def _select_more(effects, hyps, rec, fit, held, s2, N, threshold, alpha, ref, no
             if vec:
                 f.values, f.stds = tuple(float(v) for v in t), tuple(float(v) for v in d)
             new.append(f)
-        effects, thetas = new, list(th)
+        effects = _drop_redundant(new, rec, fit, s2, N, threshold, notes)
+        thetas = [e.theta for e in effects]
         quality = quality_of(effects, thetas)
     if len(effects) > 1:
         simpler = _simplify(effects, hyps, rec, fit, s2, N, threshold, notes)
@@ -537,6 +538,50 @@ def _select_more(effects, hyps, rec, fit, held, s2, N, threshold, alpha, ref, no
             effects = simpler
             quality = quality_of(effects, [e.theta for e in effects])
     return effects, quality
+
+
+def _findings_of(hs, th, sd, rss, s2, N, delta_chi2s):
+    """Findings for the jointly fitted hypotheses ``hs`` at sizes ``th`` with stds ``sd``."""
+    n_par = sum(x.n_params for x in hs)
+    out = []
+    for x, t, d, dchi in zip(hs, th, sd, delta_chi2s):
+        vec = np.ndim(t) > 0
+        t0, d0 = (float(t[0]), float(d[0])) if vec else (float(t), float(d))
+        f = Finding(x.kind, x.station, x.element, t0, x.unit, d0, rss / s2 + n_par * math.log(N), float(dchi),
+                    x.description, True, False, None if (x.gain is not None or x.added) else x.nominal + t0, x)
+        if vec:
+            f.values, f.stds = tuple(float(v) for v in t), tuple(float(v) for v in d)
+        out.append(f)
+    return out
+
+
+def _drop_redundant(effects, rec, fit, s2, N, threshold, notes):
+    """The backward step of the selection: an earlier effect that the later ones make unnecessary is dropped.
+
+    A first effect can stand in for two (a common loss of all springs imitates one weaker spring and a
+    heavier roof); once those two are in, the stand-in's joint size is noise.  Each effect but the newest
+    (which has just passed its test given the others) is removed in turn and the rest refitted jointly; the
+    one whose removal costs least is dropped when that cost is below the threshold of its parameter count,
+    against the misfit left, and the step repeats."""
+    while len(effects) > 1:
+        hs, th = [e.hypothesis for e in effects], [e.theta for e in effects]
+        full = _rss_of(Compound(rec, fit, hs).responses(th), fit.meas)
+        left = max(1.0, full / (s2 * max(N - sum(h.n_params for h in hs), 1)))
+        best = None
+        for k, e in enumerate(effects[:-1]):
+            rest, rest_th = hs[:k] + hs[k + 1:], th[:k] + th[k + 1:]
+            th2, rss2, sd2 = joint_fit(rec, fit, rest, rest_th, s2)
+            cost = (rss2 - full) / s2 / left
+            if cost < threshold_k(threshold, e.hypothesis.n_params) and (best is None or cost < best[0]):
+                best = (cost, k, rest, th2, rss2, sd2)
+        if best is None:
+            return effects
+        cost, k, rest, th2, rss2, sd2 = best
+        notes.append(f"{effects[k].description} dropped: given the later effects it improves the fit by delta "
+                     f"chi2 {cost:.1f} only (threshold {threshold_k(threshold, effects[k].hypothesis.n_params):.1f})")
+        kept = effects[:k] + effects[k + 1:]
+        effects = _findings_of(rest, th2, sd2, rss2, s2, N, [e.delta_chi2 for e in kept])
+    return effects
 
 
 def _nested_at_bound(hs, th, rss, sd, hyps, rec, fit, s2, notes):
