@@ -125,7 +125,7 @@ def _run(case):
 
 @pytest.mark.slow
 def test_grounded_spring_found_on_independent_rotor_data():
-    # covered in the default run by tests/test_diagnose.py::test_hidden_bearing_change_is_found_on_the_thesis_rotor
+    # covered in the default run by tests/test_sidebands.py::test_diagnose_reports_sidebands_for_data_taken_at_speed
     # (the diagnosis of the thesis rotor) and test_plain_model_agrees_with_the_package (the plain
     # model these data come from agrees with mutext.rotor)
     _run("spring")
