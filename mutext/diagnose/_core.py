@@ -685,16 +685,38 @@ def _screen_all(hyps, rec, fit, s2, N, rss0, threshold, tell) -> list:
             tell(f"screening hypotheses {k + 1}/{nh}", 0.05 + 0.6 * k / nh)
         ev = _Evaluator(rec, fit, h)
         if h.params:                         # k > 1 parameters: a bounded least-squares fit of the vector
-            theta, rss, stds = _fit_vector(ev, s2)
-            f = _finding(h, theta[0], stds[0], rss, rss0, s2, N, threshold)
-            f.values, f.stds = tuple(float(x) for x in theta), tuple(float(x) for x in stds)
-            findings.append(f)
+            findings.append(_vector_finding(ev, h, s2, rss0, N, threshold, quick=True))
             continue
         theta, rss = _fit_size(ev)
         std = _jacobian_std(ev, theta, s2) if rss < rss0 else math.inf
         findings.append(_finding(h, theta, std, rss, rss0, s2, N, threshold))
+    # k-parameter hypotheses were fitted quickly (one start, loose tolerances) at every location; the
+    # contenders are fitted in full: the best few of each kind, and any within the threshold of the best
+    findings.sort(key=lambda f: f.score)
+    best = findings[0].score if findings else math.inf
+    per_kind: dict = {}
+    for j, f in enumerate(findings):
+        h = f.hypothesis
+        if h is None or not h.params:
+            continue
+        per_kind[h.kind] = per_kind.get(h.kind, 0) + 1
+        if per_kind[h.kind] <= _FULL_VECTOR_FITS or f.score - best < 2 * threshold:
+            full = _vector_finding(_Evaluator(rec, fit, h), h, s2, rss0, N, threshold)
+            if full.score <= f.score:
+                findings[j] = full
     findings.sort(key=lambda f: f.score)
     return findings
+
+
+#: k-parameter hypotheses of each kind fitted in full after the screen's quick pass
+_FULL_VECTOR_FITS = 3
+
+
+def _vector_finding(ev, h, s2, rss0, N, threshold, quick=False):
+    theta, rss, stds = _fit_vector(ev, s2, quick=quick)
+    f = _finding(h, theta[0], stds[0], rss, rss0, s2, N, threshold)
+    f.values, f.stds = tuple(float(x) for x in theta), tuple(float(x) for x in stds)
+    return f
 
 
 def _refit_best(findings, refit, model_text, path, eng, fit, s2, N, rss0, threshold, tell) -> list:

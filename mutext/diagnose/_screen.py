@@ -202,12 +202,14 @@ def _fit_size(ev: _Evaluator, n_scan: int = 25, gn_iter: int = 30):
     return t, best
 
 
-def _fit_vector(ev: _Evaluator, s2: float, n_best: int = 3):
+def _fit_vector(ev: _Evaluator, s2: float, n_best: int = 3, quick: bool = False):
     """Least-squares parameter vector of a k-parameter hypothesis (all parameters positive).
 
     The hypothesis's starting vectors are ranked by the residual; the best ``n_best`` start a bounded
     least-squares fit in the logarithms of the parameters.  Returns ``(theta, rss, stds)``, the standard
-    uncertainties from the Jacobian at the optimum (first order: ``std_i = theta_i * std(ln theta_i)``)."""
+    uncertainties from the Jacobian at the optimum (first order: ``std_i = theta_i * std(ln theta_i)``).
+    ``quick``: the best start only, a short fit to loose tolerances (the screen's first pass over every
+    location; the contenders are then fitted in full)."""
     import scipy.optimize as so
     h = ev.hyp
     meas = ev.data.meas
@@ -227,7 +229,7 @@ def _fit_vector(ev: _Evaluator, s2: float, n_best: int = 3):
     starts = [np.clip(np.log(np.asarray(t, float)), lo, hi) for t in h.starts]
     ranked = sorted(((float(np.sum(resid(x) ** 2)), k) for k, x in enumerate(starts)))
     best = None
-    for _, k in ranked[:n_best]:
+    for _, k in ranked[:1 if quick else n_best]:
         # a lightly damped resonance of the added part is a narrow valley: its frequency first, by the first
         # parameter alone (a mass, at the others held), within 10 % either side of the start
         x = starts[k].copy()
@@ -241,8 +243,9 @@ def _fit_vector(ev: _Evaluator, s2: float, n_best: int = 3):
             r1 = so.minimize_scalar(along, bounds=(a, b), method="bounded", options={"xatol": 1e-8})
             if r1.fun < along(x[0]):
                 x[0] = float(r1.x)
-        sol = so.least_squares(resid, x, bounds=(lo, hi), method="trf", x_scale="jac", max_nfev=1000,
-                               ftol=1e-12, xtol=1e-12)
+        sol = so.least_squares(resid, x, bounds=(lo, hi), method="trf", x_scale="jac",
+                               max_nfev=40 if quick else 1000, ftol=1e-6 if quick else 1e-12,
+                               xtol=1e-6 if quick else 1e-12)
         rss = float(np.sum(sol.fun ** 2))
         if best is None or rss < best[1]:
             best = (sol.x, rss, sol.jac)
