@@ -120,17 +120,15 @@ class Modes:
 
     def whirl_direction(self, threshold: float = 0.5) -> list[str]:
         """``"forward"``, ``"backward"`` or ``"mixed"`` per mode (``""`` when not a rotor)."""
-        out = []
-        for w in self.whirl:
-            if np.isnan(w):
-                out.append("")
-            elif w > threshold:
-                out.append("forward")
-            elif w < -threshold:
-                out.append("backward")
-            else:
-                out.append("mixed")
-        return out
+        return [whirl_label(w, threshold) for w in self.whirl]
+
+
+def whirl_label(w: float, threshold: float = 0.5) -> str:
+    """A mode's whirl index ``w`` (+1 forward circle, -1 backward) read as ``"forward"``, ``"backward"``
+    or ``"mixed"`` (``""`` for NaN: no second plane)."""
+    if np.isnan(w):
+        return ""
+    return "forward" if w > threshold else "backward" if w < -threshold else "mixed"
 
 
 #: A model's responses between named ports (one home for frequency responses: :mod:`mutext.response`).

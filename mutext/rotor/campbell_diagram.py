@@ -50,7 +50,7 @@ import numpy as np
 
 from ..errors import ModelError
 from ..lti import blas_single_thread
-from .analysis import _check_n, _values, modes
+from .analysis import _check_n, _values, modes, whirl_label
 from .sparse_modal import sparse_modes
 
 __all__ = ["CampbellDiagram", "Crossing", "campbell", "log_decrement", "whirl_labels", "speed_grid"]
@@ -74,14 +74,8 @@ def whirl_labels(whirl, frequencies_hz, *, threshold: float = 0.5) -> list[str]:
         near = [s for s in (r - 1, r + 1) if 0 <= s < f.size and np.isfinite(f[s])]
         if np.isfinite(f[r]) and any(abs(f[s] - f[r]) <= DEGENERATE_TOL * abs(f[r]) for s in near):
             out.append("degenerate")
-        elif np.isnan(w):
-            out.append("")
-        elif w > threshold:
-            out.append("forward")
-        elif w < -threshold:
-            out.append("backward")
         else:
-            out.append("mixed")
+            out.append(whirl_label(w, threshold))
     return out
 
 
