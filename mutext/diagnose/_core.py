@@ -517,18 +517,7 @@ def _select_more(effects, hyps, rec, fit, held, s2, N, threshold, alpha, ref, no
             notes.append(f"no further effect accepted; the best candidate, {h.description}, given "
                          f"{len(effects)} effect(s): {why}")
             break
-        new = []
-        n_par = sum(x.n_params for x in hs)
-        for k, (x, t, d) in enumerate(zip(hs, th, sd)):
-            old = effects[k] if k < len(effects) else None
-            vec = np.ndim(t) > 0
-            t0, d0 = (float(t[0]), float(d[0])) if vec else (float(t), float(d))
-            f = Finding(x.kind, x.station, x.element, t0, x.unit, d0, rss_new / s2 + n_par * math.log(N),
-                        old.delta_chi2 if old is not None else float(dchi), x.description, True, False,
-                        None if (x.gain is not None or x.added) else x.nominal + t0, x)
-            if vec:
-                f.values, f.stds = tuple(float(v) for v in t), tuple(float(v) for v in d)
-            new.append(f)
+        new = _findings_of(hs, th, sd, rss_new, s2, N, [e.delta_chi2 for e in effects] + [dchi])
         effects = _drop_redundant(new, rec, fit, s2, N, threshold, notes)
         thetas = [e.theta for e in effects]
         quality = quality_of(effects, thetas)
