@@ -42,7 +42,13 @@ def is_real_number(x) -> bool:
     """``x`` is a real number (int, float or their numpy kinds), not a bool, a string or an array.
 
     The check in front of every scalar option (tolerances, margins, weights): what it lets through is
-    then tested for finiteness and range by the caller, which names the option in its error."""
+    then tested for finiteness and range by the caller, which names the option in its error.
+
+    Parameters
+    ----------
+    x : object
+        The value to test.
+    """
     return not isinstance(x, (bool, np.bool_)) and isinstance(x, (int, float, np.integer, np.floating))
 
 
@@ -63,6 +69,31 @@ def ss(A, B, C, D, *, inputs=None, outputs=None, states=None, name=None) -> ct.S
     Raises :class:`ModelError` naming the matrix when an entry is not a number
     (a string, ``None``) or the sizes do not fit together: ``A`` is n x n,
     ``B`` n x m, ``C`` p x n, ``D`` p x m.
+
+    Parameters
+    ----------
+    A : (n, n) array_like
+        State matrix.
+    B : (n, m) array_like
+        Input matrix.
+    C : (p, n) array_like
+        Output matrix.
+    D : (p, m) array_like
+        Feedthrough matrix.
+    inputs, outputs, states : sequence of str, optional
+        Names of the m inputs, p outputs and n states (python-control's
+        defaults ``u[i]``, ``y[i]``, ``x[i]`` when omitted).
+    name : str, optional
+        Name of the system, also used in the error messages.
+
+    Examples
+    --------
+    >>> from mutext.lti import ss
+    >>> G = ss([[-1.0]], [[1.0]], [[2.0]], [[0.0]], inputs=["u"], outputs=["y"])
+    >>> G.nstates, G.ninputs, G.noutputs
+    (1, 1, 1)
+    >>> float(G(0j).real)                  # DC gain 2/1
+    2.0
     """
     what = name or "system"
     _check_real(A, B, C, D, what=what)
@@ -128,7 +159,16 @@ def ss(A, B, C, D, *, inputs=None, outputs=None, states=None, name=None) -> ct.S
 
 def as_ss(sys, what: str = "system") -> ct.StateSpace:
     """Coerce a StateSpace, TransferFunction, (A, B, C, D) tuple or a constant
-    matrix to a continuous-time :class:`control.StateSpace`."""
+    matrix to a continuous-time :class:`control.StateSpace`.
+
+    Parameters
+    ----------
+    sys : StateSpace, TransferFunction, tuple or array_like
+        The system: a :class:`control.StateSpace` or :class:`control.TransferFunction`,
+        an ``(A, B, C, D)`` tuple, or a constant (p, m) gain matrix (no states).
+    what : str, optional
+        Name of the system in the error messages.
+    """
     if isinstance(sys, ct.StateSpace):
         _check_real(sys.A, sys.B, sys.C, sys.D, what=what)
         out = sys
@@ -173,7 +213,15 @@ def _check_real(*mats, names="ABCD", what="system"):
 
 
 def check_finite(sys: ct.StateSpace, what: str = "system") -> None:
-    """Raise :class:`ModelError` naming the first matrix with a NaN or infinite entry."""
+    """Raise :class:`ModelError` naming the first matrix with a NaN or infinite entry.
+
+    Parameters
+    ----------
+    sys : control.StateSpace
+        The system whose ``A``, ``B``, ``C``, ``D`` are checked.
+    what : str, optional
+        Name of the system in the error message.
+    """
     for name in "ABCD":
         M = np.asarray(getattr(sys, name))
         if M.size and not np.all(np.isfinite(M)):
@@ -298,6 +346,17 @@ def star(P, Q, nu: int, ny: int) -> ct.StateSpace:
 
     Raises :class:`IllPosedError` when the interconnection is not well posed
     (``I - P22(inf) Q11(inf)`` singular).
+
+    Parameters
+    ----------
+    P : StateSpace or as accepted by :func:`as_ss`
+        The upper system, inputs ``[w_P; u]`` and outputs ``[z_P; y]``.
+    Q : StateSpace or as accepted by :func:`as_ss`
+        The lower system, inputs ``[y; w_Q]`` and outputs ``[u; z_Q]``.
+    nu : int
+        Number of signals ``u`` (the last inputs of ``P``, the first outputs of ``Q``).
+    ny : int
+        Number of signals ``y`` (the last outputs of ``P``, the first inputs of ``Q``).
     """
     P = as_ss(P, "P")
     Q = as_ss(Q, "Q")
@@ -364,6 +423,25 @@ def lft_lower(P, K, nmeas: int | None = None, ncon: int | None = None) -> ct.Sta
 
     ``K`` maps the last ``nmeas`` outputs of ``P`` to its last ``ncon`` inputs
     (defaults: the sizes of ``K``).  Same convention as :func:`control.hinfsyn`.
+
+    Parameters
+    ----------
+    P : StateSpace or as accepted by :func:`as_ss`
+        Generalised plant, inputs ``[w; u]`` and outputs ``[z; y]``.
+    K : StateSpace or as accepted by :func:`as_ss`
+        Controller from the ``nmeas`` measurements ``y`` to the ``ncon`` controls ``u``.
+    nmeas : int, optional
+        Number of measurements (the last outputs of ``P``); default: the inputs of ``K``.
+    ncon : int, optional
+        Number of controls (the last inputs of ``P``); default: the outputs of ``K``.
+
+    Examples
+    --------
+    >>> from mutext.lti import ss, lft_lower
+    >>> P = ss([[-1.0]], [[1.0, 1.0]], [[1.0], [1.0]], [[0.0, 0.0], [0.0, 0.0]])
+    >>> CL = lft_lower(P, ss([], [], [], [[-1.0]]))     # static feedback u = -y
+    >>> [round(float(p.real), 6) for p in CL.poles()]   # the pole moves from -1 to -2
+    [-2.0]
     """
     K = as_ss(K, "K")
     nmeas = K.ninputs if nmeas is None else nmeas
@@ -379,6 +457,18 @@ def lft_upper(P, Delta, nrow: int | None = None, ncol: int | None = None) -> ct.
 
     ``Delta`` maps the first ``ncol`` outputs of ``P`` to its first ``nrow``
     inputs (defaults: the sizes of ``Delta``).
+
+    Parameters
+    ----------
+    P : StateSpace or as accepted by :func:`as_ss`
+        System with inputs ``[w_Delta; w]`` and outputs ``[z_Delta; z]``.
+    Delta : StateSpace or as accepted by :func:`as_ss`
+        The block closed around the first ``ncol`` outputs and ``nrow`` inputs of ``P``
+        (a constant matrix is accepted).
+    nrow : int, optional
+        Number of outputs of ``Delta`` (the first inputs of ``P``); default: from ``Delta``.
+    ncol : int, optional
+        Number of inputs of ``Delta`` (the first outputs of ``P``); default: from ``Delta``.
     """
     P = as_ss(P, "P")
     Delta = as_ss(Delta, "Delta")
@@ -401,6 +491,27 @@ def lft_matrix(M, Delta, nrow: int, ncol: int, upper: bool = True) -> np.ndarray
     With ``upper=True``: :math:`M_{22} + M_{21}\Delta(I - M_{11}\Delta)^{-1}M_{12}` where
     ``M11`` is ``ncol x nrow`` (``Delta`` is ``nrow x ncol``); with ``upper=False``
     the lower LFT with ``M22`` of size ``ncol x nrow``.
+
+    Parameters
+    ----------
+    M : (p, m) array_like
+        The constant (real or complex) matrix.
+    Delta : (nrow, ncol) array_like
+        The block closed around ``M``.
+    nrow, ncol : int
+        Size of ``Delta``: ``nrow`` of ``M``'s inputs are driven by it, ``ncol`` of its
+        outputs drive it.
+    upper : bool, optional
+        Close ``Delta`` around the first inputs/outputs (upper LFT, default) or the
+        last ones (lower LFT).
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from mutext.lti import lft_matrix
+    >>> M = np.array([[0.5, 1.0], [1.0, 2.0]])
+    >>> lft_matrix(M, [[1.0]], 1, 1)          # 2 + 1 * 1 / (1 - 0.5) * 1
+    array([[4.]])
     """
     M = np.atleast_2d(np.asarray(M))
     Delta = np.atleast_2d(np.asarray(Delta))
@@ -458,6 +569,24 @@ def freqresp(sys, omega) -> np.ndarray:
     above are right to 1e-9 and 1e-7 (checked against 50-digit ``mpmath``;
     ``benchmarks/bench_freqresp.py`` prints accuracy and time beside
     python-control's).
+
+    Parameters
+    ----------
+    sys : StateSpace or as accepted by :func:`as_ss`
+        The continuous-time system.
+    omega : float or (N,) array_like
+        Frequencies in rad/s (finite, non-negative).
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from mutext.lti import ss, freqresp
+    >>> G = ss([[-1.0]], [[1.0]], [[1.0]], [[0.0]])     # 1/(s + 1)
+    >>> H = freqresp(G, [0.0, 1.0])
+    >>> H.shape
+    (1, 1, 2)
+    >>> np.round(np.abs(H[0, 0]), 4)                    # 1 and 1/sqrt(2)
+    array([1.    , 0.7071])
     """
     sys = as_ss(sys)
     check_finite(sys)
@@ -569,7 +698,15 @@ def _backward_error_ok(A, B, w, X, absA, absB, tol):
 
 
 def sigma_max(sys, omega) -> np.ndarray:
-    """Largest singular value of ``G(j w)`` at each frequency (rad/s)."""
+    """Largest singular value of ``G(j w)`` at each frequency (rad/s).
+
+    Parameters
+    ----------
+    sys : StateSpace or as accepted by :func:`as_ss`
+        The continuous-time system.
+    omega : float or (N,) array_like
+        Frequencies in rad/s.
+    """
     G = freqresp(sys, omega)
     if min(G.shape[:2]) == 0:
         return np.zeros(G.shape[2])
@@ -666,12 +803,32 @@ def stability(sys, margin: float = 0.0) -> Stability:
 
 def is_stable(sys, margin: float = 0.0) -> bool:
     """True if every pole has real part < -margin and is decidably off the
-    imaginary axis (scale-aware rule, see :func:`stability`)."""
+    imaginary axis (scale-aware rule, see :func:`stability`).
+
+    Parameters
+    ----------
+    sys : StateSpace or as accepted by :func:`as_ss`
+        The continuous-time system.
+    margin : float, optional
+        Required distance of every pole to the left of the imaginary axis (1/s).
+    """
     return stability(sys, margin).stable
 
 
 def closed_loop_poles(P, K, nmeas: int, ncon: int) -> np.ndarray:
-    """Poles of the closed loop F_l(P, K)."""
+    """Poles of the closed loop F_l(P, K).
+
+    Parameters
+    ----------
+    P : StateSpace or as accepted by :func:`as_ss`
+        Generalised plant, inputs ``[w; u]`` and outputs ``[z; y]``.
+    K : StateSpace or as accepted by :func:`as_ss`
+        Controller from ``y`` to ``u``.
+    nmeas : int
+        Number of measurements ``y`` (the last outputs of ``P``).
+    ncon : int
+        Number of controls ``u`` (the last inputs of ``P``).
+    """
     CL = lft_lower(P, K, nmeas, ncon)
     return np.linalg.eigvals(np.asarray(CL.A, float)) if CL.nstates else np.zeros(0)
 
@@ -682,6 +839,13 @@ def balance_states(sys, iterations: int = 50):
     Returns ``(scaled_sys, t)`` with ``x = diag(t) x_scaled``; the transfer
     function is unchanged.  Powers of two keep the scaling exact in floating
     point (an Osborne/Parlett-Reinsch iteration restricted to the states).
+
+    Parameters
+    ----------
+    sys : StateSpace or as accepted by :func:`as_ss`
+        The system to scale.
+    iterations : int, optional
+        Maximum number of sweeps over the states (stops earlier when no scale changes).
     """
     sys = as_ss(sys)
     A, B, C = (np.asarray(X, float).copy() for X in (sys.A, sys.B, sys.C))
@@ -806,6 +970,14 @@ def hinf_norm(sys, rtol: float = 1e-10, *, require_stable: bool = True) -> HinfN
     The gain is computed on ``G / s`` with ``s`` the size of ``B``, ``C`` and
     ``D`` (an exact rescaling), so systems scaled by 1e-160 or 1e300 give their
     norm, not an overflow; a norm beyond the largest double is ``inf``.
+
+    Examples
+    --------
+    >>> from mutext.lti import ss, hinf_norm
+    >>> G = ss([[0.0, 1.0], [-1.0, -0.2]], [[0.0], [1.0]], [[1.0, 0.0]], [[0.0]])   # 1/(s^2 + 0.2 s + 1)
+    >>> r = hinf_norm(G)
+    >>> round(r.value, 3), round(r.frequency, 3)       # the resonance peak 1/(2 zeta sqrt(1 - zeta^2))
+    (5.025, 0.99)
     """
     if not is_real_number(rtol) or not np.isfinite(rtol) or not 0 < rtol < 1:
         raise ModelError(f"hinf_norm: rtol must be a number between 0 and 1 (exclusive), got {rtol!r}")
