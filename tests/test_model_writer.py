@@ -253,3 +253,98 @@ def test_a_distributed_change_is_written_into_every_spring_of_its_run():
         dK = ext.matrices()[2] - model.matrices()[2]
         assert np.allclose(dK[np.ix_(h.dofs, h.dofs)], -0.08 * h.pattern, rtol=1e-12, atol=1e-12)
         assert all(c in out for c in _comments(text))
+
+
+# ---------------------------------------------------------------------------
+# [[impedance]]: a rational dynamic stiffness to ground, written and read back
+# ---------------------------------------------------------------------------
+
+def _three_mass_text() -> str:
+    with open(THREE_MASS, encoding="utf-8") as fh:
+        return fh.read()
+
+
+def _with_impedance(num, den, mass="m2") -> str:
+    mf = ModelFile(_three_mass_text())
+    mf.append("impedance", {"name": "K_test", "mass": mass, "numerator": list(num), "denominator": list(den)},
+              "a rational impedance")
+    return mf.text()
+
+
+def test_impedance_round_trip_keeps_coefficients_bit_for_bit():
+    # coefficients with many digits: the file must hold the same doubles
+    num = [0.123456789012345678, 21.987654321, 903.0000000001]
+    den = [1.0, 8.33333333333333, 401.1111111111]
+    text = _with_impedance(num, den)
+    doc = tomllib.loads(text)
+    assert doc["impedance"][0]["numerator"] == num and doc["impedance"][0]["denominator"] == den
+    el = loads_model(text).element_by_name["K_test"]
+    assert el.numerator.tolist() == num and el.denominator.tolist() == den
+    assert el.nodes == (2,) and el.order == 2
+    # the comments of the original file survive
+    assert set(_comments(_three_mass_text())) <= set(_comments(text))
+
+
+def test_impedance_frf_and_state_space_equal_the_base_model_with_k_in_feedback():
+    import control as ct
+    num, den = [1.0, 60.0, 7000.0], [1.0, 6.0, 350.0]
+    base = loads_model(_three_mass_text())
+    ext = loads_model(_with_impedance(num, den))
+    f = np.linspace(0.3, 6.0, 80)
+    # independent: python-control closes u = -K(s) x2 around the base model's state space with a force at m2
+    plant = loads_model(_three_mass_text() + '\n[[force]]\nname = "u_K"\nmass = "m2"\n[[sensor]]\nname = "y_K"\n'
+                        'mass = "m2"\n').state_space(inputs=["f1", "u_K"], outputs=["x1", "x3", "y_K"])
+    Kblk = ct.ss(ct.tf([[[0.0], [0.0], [0.0]], [[0.0], [0.0], num]],
+                       [[[1.0], [1.0], [1.0]], [[1.0], [1.0], den]]))
+    closed = ct.feedback(plant, Kblk, sign=-1)
+    ref = closed.frequency_response(2 * np.pi * f).frdata[:2, 0, :]
+    H = ext.frf(f, inputs=["f1"], outputs=["x1", "x3"]).H[:, 0, :]
+    assert np.max(np.abs(H - ref) / np.abs(ref)) < 1e-9
+    S = ext.state_space(inputs=["f1"], outputs=["x1", "x3"])
+    assert S.nstates == base.state_space().nstates + 2
+    Hs = S.frequency_response(2 * np.pi * f).frdata[:, 0, :]
+    assert np.max(np.abs(Hs - ref) / np.abs(ref)) < 1e-9
+    # the element changes the response (the check above is not trivially the base model)
+    H0 = base.frf(f, inputs=["f1"], outputs=["x1", "x3"]).H[:, 0, :]
+    assert np.max(np.abs(H0 - ref) / np.abs(ref)) > 0.1
+
+
+@pytest.mark.parametrize("num, den, match", [
+    ([1.0, 2.0, 3.0], [1.0, 2.0], "numerator: degree 2 exceeds"),
+    ([1.0], [0.0, 1.0], "denominator: the leading coefficient"),
+    ([0.0, 0.0], [1.0, 1.0], "numerator: all coefficients are 0"),
+    ([1.0], [1.0, 0.0, 4.0], "denominator: a pole on the imaginary axis"),
+    ([1.0], [], r"\[\[impedance\]\] #1, denominator"),
+    ([1.0, "a"], [1.0, 1.0], r"\[\[impedance\]\] #1, numerator\[1\]"),
+])
+def test_impedance_bad_coefficients_name_the_field(num, den, match):
+    text = _three_mass_text() + (f'\n[[impedance]]\nname = "Kbad"\nmass = "m1"\nnumerator = {_toml_list(num)}\n'
+                                 f'denominator = {_toml_list(den)}\n')
+    with pytest.raises(ModelError, match=match):
+        loads_model(text)
+
+
+def _toml_list(v) -> str:
+    return "[" + ", ".join(f'"{x}"' if isinstance(x, str) else repr(float(x)) for x in v) + "]"
+
+
+def test_impedance_unknown_mass_and_key_are_named():
+    bad_mass = _three_mass_text() + '\n[[impedance]]\nname = "K"\nmass = "m9"\nnumerator = [1.0]\ndenominator = [1.0]\n'
+    with pytest.raises(ModelError, match=r"\[\[impedance\]\] #1, mass: unknown mass 'm9'"):
+        loads_model(bad_mass)
+    bad_key = bad_mass.replace('mass = "m9"', 'mass = "m1"\nnumerater = [1.0]')
+    with pytest.raises(ModelError, match="unknown key 'numerater'"):
+        loads_model(bad_key)
+
+
+def test_impedance_writer_refuses_non_finite_coefficients():
+    mf = ModelFile(_three_mass_text())
+    with pytest.raises(ModelError, match=r"new \[\[impedance\]\] entry, 'numerator'\[1\]"):
+        mf.append("impedance", {"name": "K", "mass": "m1", "numerator": [1.0, float("nan")],
+                                "denominator": [1.0, 1.0]})
+
+
+def test_modes_of_a_model_with_an_impedance_are_refused_by_name():
+    ext = loads_model(_with_impedance([1.0, 10.0], [1.0, 5.0]))
+    with pytest.raises(ModelError, match="impedance element 'K_test'"):
+        ext.natural_frequencies()

@@ -224,12 +224,23 @@ def modes(model, *, speed: float | None = None, values=None, n: int | None = Non
         Precomputed ``model.matrices(values)``.
     """
     n = _check_n(n)
+    _no_impedance(model, "modes")
     if not (isinstance(rigid_tol, (int, float, np.integer, np.floating)) and 0 <= rigid_tol < 1):
         raise ModelError(f"rigid_tol must lie in [0, 1), got {rigid_tol!r}")
     if matrices is None:
         values = _values(model, values)
     with blas_single_thread():
         return _modes(model, _speed(model, speed), values, n, rigid_tol, matrices)
+
+
+def _no_impedance(model, what: str) -> None:
+    """A clear error where a rational impedance element (extra states, not in M, C, K) would be left out."""
+    from .lumped_elements import impedances
+    imp = impedances(model)
+    if imp:
+        raise ModelError(f"{model.name}: {what} are computed from M, C and K alone, which the impedance element "
+                         f"'{imp[0].name}' is not part of (it adds {imp[0].order} states); use "
+                         "state_space(model).poles() or frf(model, ...)")
 
 
 def _modes(model, speed, values, n, rigid_tol, matrices) -> Modes:
@@ -423,12 +434,17 @@ def _frf(model, f, ins, outs, speed, v) -> FRF:
     B = model.input_matrix(v)[:, [model.input_names.index(q) for q in ins]]
     Cy = model.output_matrix()[[model.output_names.index(q) for q in outs]]
     D = C + speed * G
+    from .lumped_elements import impedances
+    imp = impedances(model)
+    dofs = {el.name: el.dofs(model.layout)[0] for el in imp}
     H = np.empty((len(outs), len(ins), f.size), dtype=complex)
     w = 2 * np.pi * f
     chunk = max(1, int(2_000_000 // max(M.size, 1)))     # about 32 MB of complex matrices at a time
     for k0 in range(0, f.size, chunk):
         wk = w[k0:k0 + chunk, None, None]
         Z = K[None] - wk * wk * M[None] + 1j * wk * D[None]       # dynamic stiffness, batched
+        for el in imp:                                            # rational impedances: K(jw) on their DOF
+            Z[:, dofs[el.name], dofs[el.name]] += el.response(w[k0:k0 + chunk])
         X = np.linalg.solve(Z, np.broadcast_to(B, (wk.shape[0],) + B.shape))
         H[:, :, k0:k0 + chunk] = np.moveaxis(Cy[None] @ X, 0, -1)
     return FRFMatrix(f, H, ins, outs, speed, _port_info(model, ins, outs))
@@ -463,4 +479,38 @@ def state_space(model, *, inputs: Sequence[str] | None = None, outputs: Sequence
     B = model.input_matrix(v)
     in_map = {q: B[:, model.input_names.index(q)] for q in ins}
     out_map = {q: model.output_dofs[model.output_names.index(q)] for q in outs}
-    return mck_to_ss(M, C + speed * G, K, inputs=in_map, outputs=out_map, dof_names=model.dof_names)
+    sys = mck_to_ss(M, C + speed * G, K, inputs=in_map, outputs=out_map, dof_names=model.dof_names)
+    from .lumped_elements import impedances
+    for el in impedances(model):
+        sys = _close_impedance(sys, el, M, el.dofs(model.layout)[0])
+    return sys
+
+
+def _close_impedance(sys, el, M, dof: int):
+    r"""``sys`` (state :math:`[q; \dot q; \ldots]`) with the force :math:`-K(s)q_d` of impedance ``el`` fed back.
+
+    With :math:`\dot z = A_k z + B_k q_d` and :math:`f = C_k z + D_k q_d`, the force
+    enters the acceleration rows as :math:`-M^{-1}e_d f`; with
+    :math:`b_d = [0;\ M^{-1}e_d;\ 0]` and :math:`c_d` selecting :math:`q_d`, the closed loop is
+
+    .. math::
+        \begin{bmatrix}\dot x\\ \dot z\end{bmatrix} =
+        \begin{bmatrix} A - b_d D_k c_d & -b_d C_k\\ B_k c_d & A_k\end{bmatrix}
+        \begin{bmatrix} x\\ z\end{bmatrix} + \begin{bmatrix} B\\ 0\end{bmatrix}u.
+    """
+    import control as ct
+    A, B, C, D = (np.asarray(X, float) for X in (sys.A, sys.B, sys.C, sys.D))
+    Ak, Bk, Ck, Dk = (np.asarray(X, float) for X in el.realisation())
+    ndof, n, nk = M.shape[0], A.shape[0], el.order
+    Ak, Bk, Ck, Dk = Ak.reshape(nk, nk), Bk.reshape(nk, 1), Ck.reshape(1, nk), Dk.reshape(1, 1)
+    e = np.zeros(ndof)
+    e[dof] = 1.0
+    bd = np.zeros((n, 1))
+    bd[ndof:2 * ndof, 0] = np.linalg.solve(M, e)
+    cd = np.zeros((1, n))
+    cd[0, dof] = 1.0
+    A2 = np.block([[A - bd @ Dk @ cd, -bd @ Ck], [Bk @ cd, Ak]])
+    B2 = np.vstack([B, np.zeros((nk, B.shape[1]))])
+    C2 = np.hstack([C, np.zeros((C.shape[0], nk))])
+    states = list(sys.state_labels) + [f"{el.name}.z{i + 1}" for i in range(nk)]
+    return ct.ss(A2, B2, C2, D, inputs=list(sys.input_labels), outputs=list(sys.output_labels), states=states)

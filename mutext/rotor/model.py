@@ -99,6 +99,19 @@ Lumped chains
     [[sensor]]
     name = "x1"
     mass = "m1"
+    [[impedance]]                 # a rational dynamic stiffness K(s) to ground at a mass (optional)
+    name = "K_m2"
+    mass = "m2"
+    numerator = [0.5, 40.0, 900.0]    # coefficients of s^2, s, 1: K(s) in N/m
+    denominator = [1.0, 20.0]         # coefficients of s, 1 (degree >= the numerator's)
+
+``[[impedance]]`` applies the force :math:`-K(s)\,x` to its mass
+(:class:`~mutext.rotor.lumped_elements.Impedance`): the frequency response
+adds :math:`K(j\omega)` to the dynamic stiffness and the state space gains
+its states.  It is how :mod:`mutext.diagnose` writes what model-based
+identification found when that is not a mass, a damper and a spring.  It has
+no tunable parameter; undamped modes and tuning refuse a model that holds one.
+In an inch-pound file :math:`K` is in lbf/in (the numerator is converted).
 
 Damping
 -------
@@ -145,6 +158,7 @@ from . import units as U
 from .assembly import ModalDamping, Rotor, Structure
 from .elements import (BearingElement, Damper, DiskElement, ExciterElement, InputPort, OutputPort, Param,
                        PointMass, ShaftElement, Spring, StructuralDamping)
+from .lumped_elements import Impedance
 from .table import Station, StationTable, read_station_table
 
 __all__ = ["load_model", "loads_model", "rotor_from_table", "DEFAULT_POISSON_RATIO"]
@@ -154,7 +168,8 @@ DEFAULT_POISSON_RATIO = 0.3
 
 _TOP_ROTOR = {"name", "units", "planes", "speed", "speed_rpm", "shaft", "station", "disk", "bearing",
               "exciter", "force", "sensor", "damping", "crack", "description"}
-_TOP_LUMPED = {"name", "units", "mass", "spring", "damper", "force", "sensor", "damping", "description"}
+_TOP_LUMPED = {"name", "units", "mass", "spring", "damper", "force", "sensor", "damping", "description",
+               "impedance"}
 
 # key -> quantity (None: not a number, handled separately)
 _SHAFT = {"station_table": None, "poisson_ratio": "dimensionless", "shear_modulus": "modulus",
@@ -175,6 +190,7 @@ _MASS = {"name": None, "mass": "mass"}
 _SPRING = {"name": None, "between": None, "stiffness": "stiffness"}
 _DAMPER = {"name": None, "between": None, "damping": "damping"}
 _PORT_LUMPED = {"name": None, "mass": None}
+_IMPEDANCE = {"name": None, "mass": None, "numerator": None, "denominator": None}
 _DAMPING = {"modal": "dimensionless", "alpha": None, "beta": None}
 
 
@@ -613,6 +629,8 @@ def _load_lumped(ctx: _Ctx, doc: dict) -> Structure:
             a, b = ends(t, where)
             par = Param(name, ctx.number(t, field, qty, where), unit, field)
             els.append(cls(a, b, name=name, **({"k": par} if key == "spring" else {"c": par})))
+    for k, t in enumerate(_array_of_tables(ctx, doc, "impedance"), start=1):
+        els.append(_impedance(ctx, t, f"[[impedance]] #{k}", node))
     ins, outs = [], []
     for key, lst, cls in (("force", ins, InputPort), ("sensor", outs, OutputPort)):
         for k, t in enumerate(_array_of_tables(ctx, doc, key), start=1):
@@ -636,6 +654,31 @@ def _load_lumped(ctx: _Ctx, doc: dict) -> Structure:
     s.source = ctx.source
     s.units = ctx.system
     return s
+
+
+def _impedance(ctx: _Ctx, t, where: str, node: dict) -> Impedance:
+    """An ``[[impedance]]`` table: a rational dynamic stiffness to ground at a mass."""
+    ctx.check_keys(t, _IMPEDANCE, where, required=("name", "mass", "numerator", "denominator"))
+    name = ctx.string(t, "name", where)
+    m = ctx.string(t, "mass", where)
+    if m not in node:
+        raise ctx.err(f"{where}, mass", f"unknown mass '{m}' (masses: {', '.join(node)})")
+    coef = {}
+    for key in ("numerator", "denominator"):
+        c = t[key]
+        if not isinstance(c, list) or not c:
+            raise ctx.err(f"{where}, {key}", f"expected a non-empty list of numbers (coefficients in descending "
+                          f"powers of s), got {c!r}")
+        for j, x in enumerate(c):
+            if isinstance(x, bool) or not isinstance(x, (int, float)) or not math.isfinite(x):
+                raise ctx.err(f"{where}, {key}[{j}]", f"expected a finite number, got {x!r}")
+        coef[key] = [float(x) for x in c]
+    # K = numerator/denominator is a stiffness: the numerator carries the unit
+    num = [U.to_si(x, "stiffness", ctx.system) for x in coef["numerator"]]
+    try:
+        return Impedance(node[m], num, coef["denominator"], name=name)
+    except ModelError as exc:
+        raise ctx.err(where, str(exc)) from None
 
 
 # ---------------------------------------------------------------------------

@@ -17,7 +17,8 @@ Three edits cover what :mod:`mutext.diagnose` writes:
 
 * :meth:`ModelFile.set` -- ``key = value`` in the *k*-th ``[[table]]`` a
   predicate selects (the old value kept in a comment);
-* :meth:`ModelFile.append` -- a new ``[[table]]`` entry, with a comment line;
+* :meth:`ModelFile.append` -- a new ``[[table]]`` entry, with a comment line (a list of
+  numbers, e.g. the coefficients of an ``[[impedance]]``, written number by number);
 * :meth:`ModelFile.scale` -- every listed key of every listed table multiplied
   by a factor (e.g. all damping values).
 
@@ -119,7 +120,13 @@ class ModelFile:
             new.add(tomlkit.comment(note))
         for key, v in entries.items():
             where = f"{self.source}: new [[{table}]] entry, '{key}'"
-            if isinstance(v, (str, bool, list, int)):
+            if isinstance(v, (list, tuple)) and v and not any(isinstance(x, str) for x in v):
+                # coefficients (an [[impedance]]'s numerator): each a finite number in full precision
+                arr = tomlkit.array()
+                for j, x in enumerate(v):
+                    arr.append(_number(x.item() if hasattr(x, "item") else x, f"{where}[{j}]"))
+                new[key] = arr
+            elif isinstance(v, (str, bool, list, int)):
                 new[key] = v                # names, flags, stations and counts as given
             else:
                 new[key] = _number(v, where)
