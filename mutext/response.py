@@ -52,6 +52,19 @@ DIRECTIONS = ("x", "y")
 class FRFFileError(ModelError):
     """A malformed FRF file; the message names the file, the line and the field.
 
+    Parameters
+    ----------
+    path : str
+        The file.
+    line : int or None
+        1-based line number, or None for whole-file problems.
+    field : str or None
+        Header key or column concerned.
+    problem : str
+        What is wrong, in words (the end of the message).
+    dataset : int or None, optional
+        For a Universal File: the 1-based position of the data set.
+
     Attributes
     ----------
     path : str
@@ -174,7 +187,13 @@ class FRF:
         return f"{self.output_unit}/{self.input_unit}"
 
     def response_in(self, output_unit: str) -> np.ndarray:
-        """The response expressed in ``output_unit`` per SI input unit (e.g. ``um`` -> um/A)."""
+        """The response expressed in ``output_unit`` per SI input unit (e.g. ``um`` -> um/A).
+
+        Parameters
+        ----------
+        output_unit : str
+            A unit of the FRF's output quantity, e.g. ``"m"``, ``"mm"``, ``"um"`` for a displacement.
+        """
         units = OUTPUT_UNITS[self.output_quantity]
         if output_unit not in units:
             raise ModelError(f"unknown {self.output_quantity} unit {output_unit!r}; "
@@ -182,7 +201,13 @@ class FRF:
         return self.response / units[output_unit]
 
     def band(self, fmin: float, fmax: float) -> "FRF":
-        """The part of the FRF with ``fmin <= f <= fmax`` [Hz] (e.g. the 20-225 Hz analysis band)."""
+        """The part of the FRF with ``fmin <= f <= fmax`` [Hz] (e.g. the 20-225 Hz analysis band).
+
+        Parameters
+        ----------
+        fmin, fmax : float
+            The band's edges in Hz (inclusive).
+        """
         keep = (self.freq_hz >= fmin) & (self.freq_hz <= fmax)
         if not np.any(keep):
             raise ModelError(f"FRF has no frequency in [{fmin}, {fmax}] Hz "
@@ -208,6 +233,19 @@ class FRFMatrix:
     ``"force"``, ``"current"``, ``"displacement"``, or ``None`` for moments
     and rotations), so that :meth:`channel` returns a :class:`FRF` that
     knows where it was taken.
+
+    Attributes
+    ----------
+    freqs_hz : (N,) ndarray
+        Frequencies in Hz.
+    H : (n_outputs, n_inputs, N) complex ndarray
+        The responses, output unit per input unit.
+    inputs, outputs : list of str
+        Port names of the columns and rows of ``H``.
+    speed : float
+        Rotor speed in rad/s at which the responses were computed (0 for a standing rotor).
+    ports : dict
+        Port name -> ``(station, direction, quantity)``.
     """
     freqs_hz: np.ndarray
     H: np.ndarray
@@ -225,7 +263,15 @@ class FRFMatrix:
                              f"asked for {in_port} -> {out_port}") from None
 
     def channel(self, out_port: str, in_port: str) -> FRF:
-        """One channel as a :class:`FRF` (stations, directions, names, quantities and speed set)."""
+        """One channel as a :class:`FRF` (stations, directions, names, quantities and speed set).
+
+        Parameters
+        ----------
+        out_port : str
+            Name of the output port (a row of ``H``).
+        in_port : str
+            Name of the input port (a column of ``H``).
+        """
         H = self(out_port, in_port)
         si, di, qi = self.ports.get(in_port, (None, "x", "force"))
         so, do, qo = self.ports.get(out_port, (None, "x", "displacement"))
@@ -249,7 +295,21 @@ class FRFMatrix:
 
 def local_extrema(freq_hz, magnitude):
     """Frequencies of the local maxima and minima of a sampled magnitude (peaks and notches as
-    sampled, ends excluded): ``(maxima, minima)``."""
+    sampled, ends excluded): ``(maxima, minima)``.
+
+    Parameters
+    ----------
+    freq_hz : (N,) array_like
+        Frequencies in Hz.
+    magnitude : (N,) array_like
+        The magnitude at each frequency (any unit; dB works as well).
+
+    Examples
+    --------
+    >>> from mutext.response import local_extrema
+    >>> local_extrema([1, 2, 3, 4, 5], [1.0, 3.0, 2.0, 0.5, 1.0])
+    (array([2]), array([4]))
+    """
     f, mag = np.asarray(freq_hz), np.asarray(magnitude)
     i = np.arange(1, mag.size - 1)
     mx = i[(mag[i] > mag[i - 1]) & (mag[i] >= mag[i + 1])]
@@ -267,6 +327,24 @@ def sweep_frequencies(start: float = 20.0, stop: float = 225.0, step: float = 0.
     so that a decimal grid is written as decimals (``0.3``, not the
     ``0.30000000000000004`` of ``0.2 + 5 * 0.02``); ``stop`` is included
     when it lies on the grid to 1e-9 steps.
+
+    Parameters
+    ----------
+    start : float, optional
+        First frequency in Hz (positive).
+    stop : float, optional
+        Last frequency in Hz (included when it lies on the grid).
+    step : float, optional
+        Spacing in Hz (positive).
+
+    Examples
+    --------
+    >>> from mutext.response import sweep_frequencies
+    >>> f = sweep_frequencies()            # the thesis analysis band
+    >>> f.size, float(f[0]), float(f[-1])
+    (411, 20.0, 225.0)
+    >>> sweep_frequencies(0.1, 0.3, 0.1)
+    array([0.1, 0.2, 0.3])
     """
     start, stop, step = float(start), float(stop), float(step)
     if not (math.isfinite(start) and math.isfinite(stop) and math.isfinite(step)):

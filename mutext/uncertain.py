@@ -59,11 +59,33 @@ class UncertainParameter:
     The normalised perturbation is :math:`\delta = (p - c)/h \in [-1, 1]` with
     centre ``c`` and half-width ``h`` ([SP]_ ch. 7).
 
+    Attributes
+    ----------
+    name : str
+        Name of the parameter (as asked for by the model's ``matrices`` function).
+    nominal : float
+        Nominal value, in the parameter's unit (kg, N/m, N s/m, ...).
+    rel : float or None, optional
+        Relative half-width of the interval (0.02 is +-2 %).
+    abs : float or None, optional
+        Absolute half-width, in the parameter's unit.
+    range : (float, float) or None, optional
+        Absolute interval ``(low, high)``.
+
     Raises
     ------
     ModelError
         Empty name, non-finite values, a non-positive ``rel`` or ``abs``, a range
         with ``low >= high`` or not containing ``nominal``.
+
+    Examples
+    --------
+    >>> from mutext.uncertain import UncertainParameter
+    >>> k = UncertainParameter("k1", 450.0, rel=0.02)
+    >>> k.value(1.0), k.value(-1.0)          # the ends of 450 N/m +- 2 %
+    (459.0, 441.0)
+    >>> k.delta(454.5)
+    0.5
     """
     name: str
     nominal: float
@@ -122,11 +144,23 @@ class UncertainParameter:
         return self.center - self.halfwidth, self.center + self.halfwidth
 
     def value(self, delta: float) -> float:
-        """Parameter value for a normalised perturbation ``delta``."""
+        """Parameter value for a normalised perturbation ``delta``.
+
+        Parameters
+        ----------
+        delta : float
+            Normalised perturbation (-1 and 1 are the ends of the interval).
+        """
         return self.center + self.halfwidth * float(delta)
 
     def delta(self, value: float) -> float:
-        """Normalised perturbation of a parameter value."""
+        """Normalised perturbation of a parameter value.
+
+        Parameters
+        ----------
+        value : float
+            Parameter value, in the parameter's unit.
+        """
         return (float(value) - self.center) / self.halfwidth
 
 
@@ -153,6 +187,8 @@ class UncertainModel:
     structure : BlockStructure
         One real block per parameter (``Block.real(r_i, name)``).
     params : tuple of UncertainParameter
+    repetitions : tuple of int
+        How many times each parameter is repeated in ``Delta`` (the size ``r_i`` of its real block).
     """
     P: ct.StateSpace
     structure: BlockStructure
@@ -166,14 +202,26 @@ class UncertainModel:
         return self.structure.nrows
 
     def values(self, delta) -> dict:
-        """Parameter values for normalised perturbations (a sequence, one per parameter)."""
+        """Parameter values for normalised perturbations (a sequence, one per parameter).
+
+        Parameters
+        ----------
+        delta : (n_params,) array_like
+            Normalised perturbations, one per parameter in the order of ``params``.
+        """
         delta = np.asarray(delta, dtype=float).ravel()
         if delta.size != len(self.params):
             raise ModelError(f"expected {len(self.params)} perturbations, got {delta.size}")
         return {p.name: p.value(d) for p, d in zip(self.params, delta)}
 
     def delta_matrix(self, delta) -> np.ndarray:
-        r""":math:`\Delta = \operatorname{diag}(\delta_i I_{r_i})` for normalised perturbations."""
+        r""":math:`\Delta = \operatorname{diag}(\delta_i I_{r_i})` for normalised perturbations.
+
+        Parameters
+        ----------
+        delta : (n_params,) array_like
+            Normalised perturbations, one per parameter in the order of ``params``.
+        """
         delta = np.asarray(delta, dtype=float).ravel()
         if delta.size != len(self.params):
             raise ModelError(f"expected {len(self.params)} perturbations, got {delta.size}")
@@ -182,6 +230,13 @@ class UncertainModel:
     def delta_vector(self, Delta, tol: float = 1e-9) -> np.ndarray:
         r"""Normalised perturbations :math:`\delta_i` of a structured ``Delta``, e.g. the
         destabilising perturbation of :func:`mutext.mu.mu_lower` (its first entry per block).
+
+        Parameters
+        ----------
+        Delta : (nunc, nunc) array_like
+            A real block-diagonal perturbation of the model's structure.
+        tol : float, optional
+            Tolerance of the structure test (:meth:`BlockStructure.contains`).
 
         Raises
         ------
@@ -196,7 +251,13 @@ class UncertainModel:
                          for rs, cs in zip(self.structure.row_slices, self.structure.col_slices)])
 
     def close(self, delta) -> ct.StateSpace:
-        """The model for normalised perturbations ``delta`` (closing the upper LFT)."""
+        """The model for normalised perturbations ``delta`` (closing the upper LFT).
+
+        Parameters
+        ----------
+        delta : (n_params,) array_like
+            Normalised perturbations, one per parameter in the order of ``params``.
+        """
         D = self.delta_matrix(delta)
         return lft_upper(self.P, D, self.nunc, self.nunc)
 
@@ -205,7 +266,13 @@ class UncertainModel:
         return self.at({p.name: p.center for p in self.params})
 
     def at(self, values: Mapping[str, float]) -> ct.StateSpace:
-        """The model rebuilt from M, C, K at the given parameter values (independent of the LFT)."""
+        """The model rebuilt from M, C, K at the given parameter values (independent of the LFT).
+
+        Parameters
+        ----------
+        values : mapping of str to float
+            Parameter values by name; parameters not given stay at their interval's centre.
+        """
         full = {p.name: p.center for p in self.params}
         for k in values:
             if k not in full:
@@ -214,7 +281,17 @@ class UncertainModel:
         return self._build(full)
 
     def sample(self, n: int, rng=None, vertices: bool = False) -> np.ndarray:
-        """``n`` normalised perturbation vectors, uniform in the box (or random vertices)."""
+        """``n`` normalised perturbation vectors, uniform in the box (or random vertices).
+
+        Parameters
+        ----------
+        n : int
+            Number of vectors.
+        rng : numpy.random.Generator or int, optional
+            Random generator or seed.
+        vertices : bool, optional
+            Draw corners of the box (every entry -1 or 1) instead of uniform points.
+        """
         rng = np.random.default_rng(rng)
         if vertices:
             return rng.choice((-1.0, 1.0), size=(n, len(self.params)))
@@ -251,6 +328,9 @@ def uncertain_mck(matrices: Callable[[Mapping[str, float]], tuple], params: Sequ
     dof_names : sequence of str, optional
     affine_tol : float
         Relative tolerance of the affinity check.
+    rng : numpy.random.Generator or int, optional
+        Random generator or seed of the affinity check's random points (fixed by
+        default, so that the check is repeatable).
 
     Returns
     -------

@@ -106,6 +106,17 @@ def branch_certifies(M, structure, level: float, *, max_boxes: int = 2000) -> tu
     level is refuted: a box's centre, with complex blocks of norm at most
     :math:`1/\text{level}`, makes :math:`I - M\Delta` singular (then
     :math:`\mu \ge` ``level``).
+
+    Parameters
+    ----------
+    M : (ncols, nrows) array_like
+        The complex matrix (e.g. ``M(j w)`` at one frequency).
+    structure : BlockStructure or list
+        The block structure, or a spec accepted by :meth:`BlockStructure.from_spec`.
+    level : float
+        The level to prove ``mu`` below (positive).
+    max_boxes : int, optional
+        Budget of boxes (of the real parameters) to split before giving up.
     """
     S = _as_structure(structure)
     M = S.check(M)

@@ -18,6 +18,15 @@ def scaled_sigma(M, structure: BlockStructure, d) -> float:
 
     ``d`` holds one positive number per block; :math:`D_\ell` and :math:`D_r` repeat
     it over the block's columns and rows (:meth:`BlockStructure.expand_d`).
+
+    Parameters
+    ----------
+    M : (ncols, nrows) array_like
+        The complex matrix.
+    structure : BlockStructure
+        Its block structure.
+    d : (len(structure),) array_like
+        One positive scaling per block.
     """
     structure = _as_structure(structure)
     d = np.asarray(d, dtype=float)

@@ -40,17 +40,44 @@ class Block:
 
     @classmethod
     def full(cls, rows: int, cols: int | None = None, name: str = "") -> "Block":
-        """A full complex ``rows x cols`` block (``cols`` defaults to ``rows``)."""
+        """A full complex ``rows x cols`` block (``cols`` defaults to ``rows``).
+
+        Parameters
+        ----------
+        rows : int
+            Number of rows of the block (inputs ``w`` of ``M`` it drives).
+        cols : int, optional
+            Number of columns of the block (outputs ``z`` of ``M`` it reads); default ``rows``.
+        name : str, optional
+            Label of the block in reports and error messages.
+        """
         return cls("full", rows, rows if cols is None else cols, name)
 
     @classmethod
     def scalar(cls, n: int = 1, name: str = "") -> "Block":
-        """A repeated complex scalar :math:`\\delta I_n`."""
+        """A repeated complex scalar :math:`\\delta I_n`.
+
+        Parameters
+        ----------
+        n : int, optional
+            Number of repetitions (the block is n x n).
+        name : str, optional
+            Label of the block in reports and error messages.
+        """
         return cls("scalar", n, n, name)
 
     @classmethod
     def real(cls, n: int = 1, name: str = "") -> "Block":
-        """A repeated real scalar :math:`\\delta I_n`."""
+        """A repeated real scalar :math:`\\delta I_n`.
+
+        Parameters
+        ----------
+        n : int, optional
+            Number of repetitions (the block is n x n), e.g. how often a physical
+            parameter appears in the LFT.
+        name : str, optional
+            Label of the block, typically the parameter's name.
+        """
         return cls("real", n, n, name)
 
     @property
@@ -64,6 +91,11 @@ class BlockStructure:
 
     ``M`` must have ``ncols`` rows and ``nrows`` columns (it maps ``w`` to
     ``z``; ``Delta`` maps ``z`` back to ``w``).
+
+    Parameters
+    ----------
+    blocks : sequence of Block
+        The diagonal blocks, in the order of the rows and columns of ``Delta``.
 
     Examples
     --------
@@ -96,7 +128,20 @@ class BlockStructure:
     @classmethod
     def from_spec(cls, spec) -> "BlockStructure":
         """From a list like MATLAB's ``blk``: ``[r, c]`` full block, ``[-n, 0]``
-        repeated real scalar, ``[n, 0]`` repeated complex scalar."""
+        repeated real scalar, ``[n, 0]`` repeated complex scalar.
+
+        Parameters
+        ----------
+        spec : sequence of pairs of int
+            One ``[rows, cols]`` pair per block, MATLAB's ``blk`` convention.
+
+        Examples
+        --------
+        >>> from mutext.mu import BlockStructure
+        >>> S = BlockStructure.from_spec([[-1, 0], [2, 0], [1, 2]])   # real, repeated complex, full 1 x 2
+        >>> [b.kind for b in S.blocks], S.nrows, S.ncols
+        (['real', 'scalar', 'full'], 4, 5)
+        """
         blocks = []
         try:
             items = list(spec)
@@ -159,7 +204,13 @@ class BlockStructure:
                                for b in self.blocks])
 
     def check(self, M) -> np.ndarray:
-        """Return ``M`` as a complex array after checking its size against the structure."""
+        """Return ``M`` as a complex array after checking its size against the structure.
+
+        Parameters
+        ----------
+        M : (ncols, nrows) array_like
+            The matrix to test (maps ``w`` to ``z``).
+        """
         M = np.asarray(M)
         if M.ndim != 2:
             raise ModelError(f"M must be a matrix, got an array with {M.ndim} dimensions")
@@ -184,7 +235,14 @@ class BlockStructure:
     # -- perturbations -----------------------------------------------------
     def assemble(self, parts: Sequence) -> np.ndarray:
         """Block-diagonal ``Delta`` from one entry per block (a scalar for
-        scalar/real blocks, a matrix for full blocks)."""
+        scalar/real blocks, a matrix for full blocks).
+
+        Parameters
+        ----------
+        parts : sequence
+            One entry per block: a number for a scalar or real block (real for a real
+            block), a ``rows x cols`` matrix for a full block.
+        """
         if len(parts) != len(self.blocks):
             raise ModelError(f"expected {len(self.blocks)} blocks, got {len(parts)}")
         D = np.zeros((self.nrows, self.ncols), dtype=complex)
@@ -200,7 +258,15 @@ class BlockStructure:
         return D
 
     def random(self, rng=None, norm: float = 1.0) -> np.ndarray:
-        """A random member with every block of norm at most ``norm`` (at least one equal)."""
+        """A random member with every block of norm at most ``norm`` (at least one equal).
+
+        Parameters
+        ----------
+        rng : numpy.random.Generator or int, optional
+            Random generator or seed (``numpy.random.default_rng``).
+        norm : float, optional
+            Largest singular value of the returned ``Delta``.
+        """
         rng = np.random.default_rng(rng)
         parts = []
         for b in self.blocks:
@@ -215,11 +281,27 @@ class BlockStructure:
         return D * (norm / np.linalg.norm(D, 2))
 
     def block_norms(self, Delta) -> np.ndarray:
+        """Spectral norm of each diagonal block of ``Delta`` (one number per block).
+
+        Parameters
+        ----------
+        Delta : (nrows, ncols) array_like
+            A matrix of this structure's size.
+        """
         return np.array([np.linalg.norm(np.asarray(Delta)[rs, cs], 2)
                          for rs, cs in zip(self.row_slices, self.col_slices)])
 
     def contains(self, Delta, tol: float = 1e-10) -> bool:
-        """True if ``Delta`` has this structure (zero off-diagonal blocks, real/repeated blocks)."""
+        """True if ``Delta`` has this structure (zero off-diagonal blocks, real/repeated blocks).
+
+        Parameters
+        ----------
+        Delta : (nrows, ncols) array_like
+            The matrix to test.
+        tol : float, optional
+            Tolerance relative to ``max(1, max |Delta_ij|)`` for the zero blocks, the
+            repeated diagonals and the imaginary parts of real blocks.
+        """
         Delta = np.asarray(Delta)
         if Delta.shape != (self.nrows, self.ncols):
             return False
@@ -240,7 +322,13 @@ class BlockStructure:
     def expand_d(self, d) -> tuple[np.ndarray, np.ndarray]:
         """Diagonal scalings ``(dl, dr)`` (length ``ncols`` and ``nrows``) from one
         positive number per block: ``D_l = diag(dl)`` acts on ``z`` and
-        ``D_r = diag(dr)`` on ``w``."""
+        ``D_r = diag(dr)`` on ``w``.
+
+        Parameters
+        ----------
+        d : (len(blocks),) array_like
+            One positive scaling per block.
+        """
         d = np.asarray(d, dtype=float)
         dl = np.concatenate([np.full(b.cols, v) for b, v in zip(self.blocks, d)])
         dr = np.concatenate([np.full(b.rows, v) for b, v in zip(self.blocks, d)])

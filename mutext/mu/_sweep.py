@@ -45,6 +45,24 @@ def default_grid(sys, n: int = 200, decades: float = 1.5) -> np.ndarray:
 
     Lightly damped poles (resonances) get extra points at :math:`|\\Im p|` and
     :math:`|\\Im p| \\pm k|\\Re p|` so that a narrow peak is not stepped over.
+
+    Parameters
+    ----------
+    sys : StateSpace or as accepted by :func:`mutext.lti.as_ss`
+        The system whose poles set the range.
+    n : int, optional
+        Number of log-spaced points (the resonance points are added to them).
+    decades : float, optional
+        How far the grid reaches below the smallest and above the largest pole magnitude.
+
+    Examples
+    --------
+    >>> from mutext.lti import ss
+    >>> from mutext.mu import default_grid
+    >>> G = ss([[0.0, 1.0], [-100.0, -0.2]], [[0.0], [1.0]], [[1.0, 0.0]], [[0.0]])   # 10 rad/s, 1 % damping
+    >>> w = default_grid(G, n=50)
+    >>> bool(w.min() < 1.0 and w.max() > 100.0), bool(abs(w - 10.0).min() < 0.01)
+    (True, True)
     """
     from ..lti import as_ss
     sys = as_ss(sys)
