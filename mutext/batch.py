@@ -44,7 +44,13 @@ SUMMARY_FIELDS = ("data_set", "status", "diagnosis", "effects", "what", "kind", 
 
 
 def find_data_sets(root) -> list[Path]:
-    """Folders under ``root`` (itself included) with a ``model.toml`` and a non-empty ``measured/``."""
+    """Folders under ``root`` (itself included) with a ``model.toml`` and a non-empty ``measured/``.
+
+    Parameters
+    ----------
+    root : str or path-like
+        The folder to search (recursively).
+    """
     root = Path(root)
     if not root.is_dir():
         raise ModelError(f"batch: '{root}' is not a directory")
@@ -101,7 +107,15 @@ def _one(folder: str, out_name: str, mbi: bool) -> dict:
 
 
 def check_jobs(jobs, what: str = "batch") -> int:
-    """``jobs`` if it is a number of workers joblib accepts (positive, or negative for all cores but some)."""
+    """``jobs`` if it is a number of workers joblib accepts (positive, or negative for all cores but some).
+
+    Parameters
+    ----------
+    jobs : int
+        Number of joblib workers: positive, or negative for all cores but ``-jobs - 1``.
+    what : str, optional
+        Name of the caller in the error message.
+    """
     if isinstance(jobs, bool) or not isinstance(jobs, int) or jobs == 0:
         raise ModelError(f"{what}: jobs must be a positive number of workers or -1, got {jobs!r}")
     return jobs
@@ -149,6 +163,13 @@ def dask_backend(scheduler: str, workers: int = -1):
     or ``"local"`` for a cluster of ``workers`` processes on this machine
     (one thread each; ``-1``: one per core).  Yields a line saying where the
     work runs.  Every worker needs mutext installed (the same version).
+
+    Parameters
+    ----------
+    scheduler : str
+        Address of a running Dask scheduler, or ``"local"``.
+    workers : int, optional
+        Number of worker processes of a local cluster (``-1``: one per core).
 
     Raises
     ------

@@ -180,6 +180,18 @@ def _version() -> str:
 
 
 def main(argv=None) -> int:
+    """Entry point of the ``mutext`` command: run a subcommand and return its exit status.
+
+    Parameters
+    ----------
+    argv : list of str, optional
+        The command line without the program name (default: ``sys.argv[1:]``).
+
+    Returns
+    -------
+    int
+        The exit status.
+    """
     try:
         return _main(argv)
     except BrokenPipeError:

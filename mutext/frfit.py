@@ -85,7 +85,13 @@ class RationalFit:
     held_out_residual: float | None = None
 
     def response(self, omega) -> np.ndarray:
-        """:math:`H(j\\omega)` of the fitted model."""
+        """:math:`H(j\\omega)` of the fitted model.
+
+        Parameters
+        ----------
+        omega : float or array_like
+            Frequencies in rad/s.
+        """
         return _eval(self.poles, self.coefficients, np.asarray(omega, float))
 
 
@@ -319,6 +325,19 @@ def fit_frf_auto(omega, response, *, max_order: int = 24, tol: float = 0.02, min
     If none reaches it up to ``max_order``, the best fit is returned with a note
     (noisy data: ``tol`` below the noise level cannot be reached).  Orders
     above the number of frequencies are not tried (with a note).
+
+    Parameters
+    ----------
+    omega : (N,) array_like
+        Frequencies in rad/s.
+    response : (N,) complex array_like
+        The measured response at ``omega``.
+    max_order : int, optional
+        Highest order tried.
+    tol : float, optional
+        Target RMS relative residual.
+    min_order : int, optional
+        Lowest order tried (rounded up to an even number, at least 2).
 
     Raises
     ------

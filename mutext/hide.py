@@ -99,7 +99,13 @@ class HiddenCase:
 
 
 def example_path(name: str) -> str:
-    """Path of a shipped example model (:data:`EXAMPLES`)."""
+    """Path of a shipped example model (:data:`EXAMPLES`).
+
+    Parameters
+    ----------
+    name : str
+        A key of :data:`EXAMPLES`.
+    """
     if name not in EXAMPLES:
         raise ModelError(f"unknown example '{name}'; available: {', '.join(EXAMPLES)}")
     return str(resources.files("mutext") / "data" / EXAMPLES[name])
@@ -115,6 +121,11 @@ def plain_chain(doc: dict):
     ``forces`` and ``sensors`` map port names to 0-based mass indices.  Only
     the ``[[mass]]``, ``[[spring]]``, ``[[damper]]``, ``[[force]]`` and
     ``[[sensor]]`` tables in SI are read (what the shipped chains use).
+
+    Parameters
+    ----------
+    doc : dict
+        The parsed TOML document of a lumped-chain model file.
     """
     if doc.get("units", "SI") != "SI" or "damping" in doc:
         raise ModelError("plain_chain reads SI chains with discrete dampers only")

@@ -14,7 +14,14 @@ __all__ = ["to_json", "print_json", "plain"]
 
 
 def plain(obj):
-    """``obj`` with numpy arrays and scalars as lists and numbers, non-finite floats as strings."""
+    """``obj`` with numpy arrays and scalars as lists and numbers, non-finite floats as strings.
+
+    Parameters
+    ----------
+    obj : object
+        Dicts, lists, tuples, numbers, strings, numpy arrays and scalars; complex
+        numbers become ``[re, im]``, dict keys strings.
+    """
     if isinstance(obj, dict):
         return {str(k): plain(v) for k, v in obj.items()}
     if isinstance(obj, (list, tuple)):
@@ -31,10 +38,29 @@ def plain(obj):
 
 
 def to_json(obj) -> str:
-    """One-line strict JSON of ``obj`` (see :func:`plain`)."""
+    """One-line strict JSON of ``obj`` (see :func:`plain`).
+
+    Parameters
+    ----------
+    obj : object
+        Dicts, lists, tuples, numbers, strings, numpy arrays and scalars (anything else as ``str``).
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from mutext.jsonio import to_json
+    >>> to_json({"f": np.array([1.5, np.inf]), "n": np.int64(3), "z": 1 + 2j})
+    '{"f": [1.5, "inf"], "n": 3, "z": [1.0, 2.0]}'
+    """
     return json.dumps(plain(obj), allow_nan=False, default=str)
 
 
 def print_json(obj) -> None:
-    """Print one JSON object (the ``--json`` output of the demos and commands)."""
+    """Print one JSON object (the ``--json`` output of the demos and commands).
+
+    Parameters
+    ----------
+    obj : object
+        As for :func:`to_json`.
+    """
     print(to_json(obj))

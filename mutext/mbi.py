@@ -91,6 +91,12 @@ class MBIPlant:
     Wz_shape : mutext.frfit.MagnitudeFit or None
         The frequency shape of the allowed error: the bound at
         :math:`\omega` is :math:`W_z|S(j\omega)|` (None: flat, :math:`W_z`).
+    true : control.StateSpace or mutext.uncertain.UncertainModel
+        The true system the plant was built from.
+    engineering : control.StateSpace
+        The engineering model.
+    ports : dict
+        Names of the ports: ``excitation``, ``measurement``, ``control_input``, ``control_output``.
     """
     P: ct.StateSpace
     structure: BlockStructure
@@ -108,7 +114,13 @@ class MBIPlant:
     ncon = 1
 
     def bound(self, omega) -> np.ndarray:
-        r"""The allowed error at the frequencies ``omega`` (rad/s): :math:`W_z|S(j\omega)|`."""
+        r"""The allowed error at the frequencies ``omega`` (rad/s): :math:`W_z|S(j\omega)|`.
+
+        Parameters
+        ----------
+        omega : float or array_like
+            Frequencies in rad/s.
+        """
         omega = np.asarray(omega, float)
         if self.Wz_shape is None:
             return np.full(omega.shape, self.Wz)
@@ -325,6 +337,10 @@ class ImpedanceFit:
         Standard uncertainty of ``(dm, dc, dk)``: with the identification
         weights :math:`|s(\omega)|`, the spread that changes the normalised error
         by about one, i.e. what the measurement cannot tell apart.
+    omega : ndarray
+        The frequencies (rad/s) of the fit.
+    weight : ndarray
+        The weight :math:`|s(\omega)|` of each frequency.
     """
     dm: float
     dc: float
@@ -338,7 +354,13 @@ class ImpedanceFit:
     sigma: tuple = (np.nan, np.nan, np.nan)
 
     def response(self, omega) -> np.ndarray:
-        """:math:`dk + j\\omega dc - \\omega^2 dm`."""
+        """:math:`dk + j\\omega dc - \\omega^2 dm`.
+
+        Parameters
+        ----------
+        omega : float or array_like
+            Frequencies in rad/s.
+        """
         w = np.asarray(omega, float)
         return self.dk + 1j * w * self.dc - w ** 2 * self.dm
 
@@ -457,7 +479,25 @@ def fit_impedance(K, omega, weight=None, tol: float = 0.1) -> ImpedanceFit:
 
 @dataclass
 class WzTry:
-    """One D-K run of the W_z search."""
+    """One D-K run of the W_z search.
+
+    Attributes
+    ----------
+    Wz : float
+        The error bound tried (output unit).
+    mu_upper : float
+        Upper bound of mu of the run's final controller (the branch-and-bound bound where that was run).
+    mu_lower : float
+        Lower bound of mu of the run's final controller.
+    controller_order : int
+        Number of states of the controller.
+    seconds : float
+        Wall time of the run.
+    iterations : int
+        Number of D-K iterations.
+    mu_dg : float
+        The D-G upper bound (before branch and bound).
+    """
     Wz: float
     mu_upper: float
     mu_lower: float
@@ -498,6 +538,8 @@ class MBIResult:
     measured_fit : mutext.frfit.RationalFit or None
         When the true system was a measured FRF: the rational model that stood in
         for it, with its residual.
+    omega : ndarray
+        The frequency grid (rad/s) of the search.
     """
     K: ct.StateSpace
     Wz: float
@@ -516,11 +558,25 @@ class MBIResult:
 
     def bound(self, omega=None) -> np.ndarray:
         r"""The certified error bound at ``omega`` (default: the search grid): ``Wz``, or
-        :math:`W_z|S(j\omega)|` with a shaped bound (``weight="spread"``)."""
+        :math:`W_z|S(j\omega)|` with a shaped bound (``weight="spread"``).
+
+        Parameters
+        ----------
+        omega : array_like, optional
+            Frequencies in rad/s (default: the search grid ``omega``).
+        """
         return self.plant.bound(self.omega if omega is None else omega)
 
     def error(self, true_system, omega=None) -> np.ndarray:
-        """|x_true - x_controlled| (output unit per input unit) of a true system over ``omega``."""
+        """|x_true - x_controlled| (output unit per input unit) of a true system over ``omega``.
+
+        Parameters
+        ----------
+        true_system : control.StateSpace
+            A true system with the ports ``excitation`` and ``measurement``.
+        omega : array_like, optional
+            Frequencies in rad/s (default: the search grid ``omega``).
+        """
         omega = self.omega if omega is None else np.asarray(omega, float)
         pr = self.plant.ports
         T = as_ss(true_system)
@@ -604,6 +660,18 @@ def true_spread(true, *, excitation: str, measurement: str, omega=None, rng=0):
     :math:`r(\omega)` to all of them (:func:`wz_floor` is its maximum,
     :func:`spread_weight` its cover).
 
+    Parameters
+    ----------
+    true : mutext.uncertain.UncertainModel or control.StateSpace
+        The true system (set).
+    excitation, measurement : str
+        Names of its input and output ports.
+    omega : array_like, optional
+        Frequencies in rad/s (default: a grid around the nominal poles).
+    rng : numpy.random.Generator or int, optional
+        Random generator or seed of the interior samples of the uncertainty box (used
+        only above five parameters; fixed by default, so that the result is repeatable).
+
     Returns
     -------
     (omega, r) : tuple of numpy.ndarray
@@ -658,6 +726,9 @@ def wz_floor(true, *, excitation: str, measurement: str, Ww: float = 1.0, omega=
         Frequencies (rad/s); default: two decades around the true system's poles.
     shape : mutext.frfit.MagnitudeFit, optional
         The frequency shape of the bound (:func:`spread_weight`); default flat.
+    rng : numpy.random.Generator or int, optional
+        Random generator or seed of the interior samples of the uncertainty box (used
+        only above five parameters; fixed by default, so that the result is repeatable).
 
     Returns
     -------
@@ -718,6 +789,9 @@ def spread_weight(true, *, excitation: str, measurement: str, omega=None, floor:
     max_sections : int
         Peaking sections of the cover (two poles each; they add to the
         plant's and the controller's order).
+    rng : numpy.random.Generator or int, optional
+        Random generator or seed of the interior samples of the uncertainty box (used
+        only above five parameters; fixed by default, so that the result is repeatable).
 
     Returns
     -------
@@ -748,6 +822,21 @@ def true_from_frf(frf, engineering, *, excitation: str, measurement: str, tol: f
     and measurement of the engineering model) is fitted by a stable rational
     model (:func:`mutext.frfit.fit_frf_auto`); its inputs and outputs are
     named ``excitation`` and ``measurement``.
+
+    Parameters
+    ----------
+    frf : mutext.rig.FRF
+        The measured response (SI units).
+    engineering : control.StateSpace or as accepted by :func:`mutext.lti.as_ss`
+        The engineering model; its modes must lie in the measured band.
+    excitation, measurement : str
+        Names given to the stand-in's input and output (those of the engineering model).
+    tol : float, optional
+        Residual at which :func:`mutext.frfit.fit_frf_auto` stops raising the order.
+    max_order : int, optional
+        Highest order of the rational fit.
+    max_residual : float, optional
+        Largest RMS relative residual of the fit that is accepted.
 
     Raises
     ------
@@ -1189,7 +1278,21 @@ def _fit_on_identifiable_band(plant: MBIPlant, K, omega, notes: list) -> Impedan
 
 
 def impedance_response(coeffs: dict, omega) -> np.ndarray:
-    """:math:`dk + j\\omega dc - \\omega^2 dm` for ``coeffs = {"dm", "dc", "dk"}`` (missing keys are 0)."""
+    """:math:`dk + j\\omega dc - \\omega^2 dm` for ``coeffs = {"dm", "dc", "dk"}`` (missing keys are 0).
+
+    Parameters
+    ----------
+    coeffs : dict
+        ``{"dm": kg, "dc": N s/m, "dk": N/m}``; a missing key counts as 0.
+    omega : float or array_like
+        Frequencies in rad/s.
+
+    Examples
+    --------
+    >>> from mutext.mbi import impedance_response
+    >>> impedance_response({"dk": 100.0, "dm": 1.0}, [0.0, 10.0])     # a spring and a mass cancel at 10 rad/s
+    array([100.+0.j,   0.+0.j])
+    """
     w = np.asarray(omega, float)
     return coeffs.get("dk", 0.0) + 1j * w * coeffs.get("dc", 0.0) - w ** 2 * coeffs.get("dm", 0.0)
 
@@ -1201,7 +1304,19 @@ def relative_error(K, reference, omega, weight=None) -> float:
 
     With ``weight`` the sensitivity :math:`|s(\omega)|` of :func:`identifiable_band`
     (as :attr:`ImpedanceFit.weight` holds it), frequencies count by how strongly the
-    measurement constrains ``K`` there; without, equally."""
+    measurement constrains ``K`` there; without, equally.
+
+    Parameters
+    ----------
+    K : StateSpace or (N,) complex array_like
+        The identified dynamic stiffness (N/m): a SISO system, or its response on ``omega``.
+    reference : dict or (N,) complex array_like
+        The reference: ``{"dm", "dc", "dk"}`` (see :func:`impedance_response`) or a response on ``omega``.
+    omega : (N,) array_like
+        Frequencies in rad/s.
+    weight : (N,) array_like, optional
+        Sensitivity weight per frequency (:attr:`ImpedanceFit.weight`); equal weights if omitted.
+    """
     omega = np.asarray(omega, float)
     D = impedance_response(reference, omega) if isinstance(reference, dict) else np.asarray(reference, complex)
     Kj = np.asarray(K, complex) if isinstance(K, np.ndarray) else freqresp(as_ss(K), omega)[0, 0]
@@ -1238,6 +1353,10 @@ def required_impedance(engineering, frf, *, excitation: str, measurement: str, c
         With the four named ports.
     frf : mutext.rig.FRF
         The measured response from ``excitation`` to ``measurement`` (SI).
+    excitation, measurement : str
+        Names of the engineering model's input and output of the measured FRF.
+    control_input, control_output : str
+        Names of the force input and displacement output of the port where ``D`` acts.
 
     Returns
     -------

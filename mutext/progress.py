@@ -12,6 +12,14 @@ class ProgressLine:
     log of a library call that reports progress too (``identify(..., out=line,
     progress=line)``), and the log's lines appear below the bar instead of
     through it.
+
+    Parameters
+    ----------
+    stream : file-like, optional
+        Where the line is written (default: ``sys.stderr``).
+    enabled : bool, optional
+        False: the progress calls draw nothing (a ``--quiet`` run); log text passed to
+        :meth:`write` is still written.
     """
 
     def __init__(self, stream=None, enabled: bool = True):
@@ -24,6 +32,13 @@ class ProgressLine:
         self.bar_shown = False      # an unfinished bar is on the terminal's current line
 
     def write(self, text: str):
+        """Write log text, clearing the bar first so that the text does not run through it.
+
+        Parameters
+        ----------
+        text : str
+            Text of the log, written below the bar.
+        """
         if self.bar_shown:
             self.stream.write("\r" + " " * 110 + "\r")
             self.bar_shown = False

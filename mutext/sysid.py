@@ -49,6 +49,33 @@ def simulate_free_decay(m: float, k: float, c: float, x0: float = 0.025, duratio
 
     Returns ``(t, y)`` in s and m; ``noise`` is the standard deviation (m) of
     white measurement noise (an encoder or sensor).
+
+    Parameters
+    ----------
+    m : float
+        Mass (kg).
+    k : float
+        Stiffness (N/m).
+    c : float
+        Viscous damping (N s/m), below critical.
+    x0 : float, optional
+        Initial displacement (m).
+    duration : float, optional
+        Record length (s).
+    fs : float, optional
+        Sampling rate (Hz).
+    noise : float, optional
+        Standard deviation of white measurement noise (m).
+    rng : numpy.random.Generator or int, optional
+        Random generator or seed of the noise.
+
+    Examples
+    --------
+    >>> from mutext.sysid import simulate_free_decay, decay_estimate
+    >>> t, y = simulate_free_decay(m=2.0, k=800.0, c=1.6)        # 20 rad/s, 2 % damping
+    >>> est = decay_estimate(t, y)
+    >>> round(est.omega_n, 2), round(est.zeta_exact, 4)
+    (20.0, 0.02)
     """
     for name, v in (("m", m), ("k", k)):
         if not v > 0:
@@ -74,6 +101,13 @@ def decay_peaks(t, y):
     Each peak is refined by a least-squares parabola over a twentieth of a period,
     and peaks lower than five times the noise level (estimated from the
     second difference of the record) are dropped.
+
+    Parameters
+    ----------
+    t : (N,) array_like
+        Increasing sample times (s).
+    y : (N,) array_like
+        The record (any unit).
     """
     from scipy.signal import find_peaks
     t, y = np.asarray(t, float), np.asarray(y, float)
@@ -115,6 +149,21 @@ class DecayEstimate:
 
     ``omega`` is eq. (3.1) (the damped frequency, rad/s), ``zeta`` eq. (3.2);
     ``omega_n`` and ``zeta_exact`` undo the two approximations.
+
+    Attributes
+    ----------
+    omega : float
+        Damped frequency (rad/s), eq. (3.1).
+    zeta : float
+        Damping ratio from the logarithmic decrement, eq. (3.2).
+    omega_n : float
+        Undamped natural frequency (rad/s).
+    zeta_exact : float
+        Damping ratio without the small-damping approximation.
+    cycles : int
+        Number of periods between the two peaks used.
+    peaks : int
+        Number of clear peaks found in the record.
     """
     omega: float
     zeta: float
@@ -128,6 +177,15 @@ def decay_estimate(t, y, cycles: int | None = None) -> DecayEstimate:
     """Eqs. (3.1)-(3.2) from the first peak and the peak ``cycles`` later.
 
     By default ``cycles`` spans as many peaks as stand clear of the noise.
+
+    Parameters
+    ----------
+    t : (N,) array_like
+        Increasing sample times (s).
+    y : (N,) array_like
+        The record (any unit).
+    cycles : int, optional
+        Number of periods between the two peaks used.
     """
     tp, yp = decay_peaks(t, y)
     if tp.size < 2:
@@ -146,7 +204,21 @@ def decay_estimate(t, y, cycles: int | None = None) -> DecayEstimate:
 
 @dataclass
 class CartParameters:
-    """Cart mass ``m_c`` (kg), equivalent stiffness ``k_eq`` (N/m) and damping ``c`` (N s/m)."""
+    """Cart mass ``m_c`` (kg), equivalent stiffness ``k_eq`` (N/m) and damping ``c`` (N s/m).
+
+    Attributes
+    ----------
+    m_c : float
+        Cart mass (kg).
+    k_eq : float
+        Equivalent stiffness seen by the cart (N/m).
+    c : float
+        Viscous damping of the cart (N s/m).
+    cart : DecayEstimate
+        The bare cart's decay.
+    weighted : DecayEstimate
+        The decay with the added mass.
+    """
     m_c: float
     k_eq: float
     c: float
@@ -160,6 +232,17 @@ def cart_parameters(cart: DecayEstimate, weighted: DecayEstimate, m_w: float,
 
     ``correct_damping=False`` reproduces the thesis (damped frequency and the
     approximate decrement); ``True`` uses the exact undamped quantities.
+
+    Parameters
+    ----------
+    cart : DecayEstimate
+        Decay of the bare cart.
+    weighted : DecayEstimate
+        Decay of the cart with ``m_w`` added.
+    m_w : float
+        The added mass (kg).
+    correct_damping : bool, optional
+        Use the undamped frequencies and exact damping ratios instead of the thesis's approximations.
     """
     wc, ww = (cart.omega_n, weighted.omega_n) if correct_damping else (cart.omega, weighted.omega)
     zc = cart.zeta_exact if correct_damping else cart.zeta
@@ -172,7 +255,21 @@ def cart_parameters(cart: DecayEstimate, weighted: DecayEstimate, m_w: float,
 
 def damper_coefficient(damped: DecayEstimate, m_c: float, m_w: float, c_m: float,
                        correct_damping: bool = False) -> float:
-    """Eq. (3.6): the damper's coefficient from a decay of the weighted cart with the damper on."""
+    """Eq. (3.6): the damper's coefficient from a decay of the weighted cart with the damper on.
+
+    Parameters
+    ----------
+    damped : DecayEstimate
+        Decay of the weighted cart with the damper attached.
+    m_c : float
+        Cart mass (kg).
+    m_w : float
+        The added mass (kg).
+    c_m : float
+        The cart's own damping (N s/m), subtracted.
+    correct_damping : bool, optional
+        Use the undamped frequency and exact damping ratio instead of the thesis's approximations.
+    """
     w = damped.omega_n if correct_damping else damped.omega
     z = damped.zeta_exact if correct_damping else damped.zeta
     return float(2 * (m_c + m_w) * z * w - c_m)
@@ -196,6 +293,18 @@ def identify_three_mass(rig, m_w: float = 2.0, noise: float = 0.0, rng=0,
     air_damper : float
         The share of ``c3`` (N s/m) due to the air damper, identified by its
         own decay (eq. 3.6); 0 when cart 3 has none.
+    m_w : float, optional
+        The mass (kg) added to each cart for the second decay.
+    noise : float, optional
+        Standard deviation (m) of the measurement noise of every record.
+    rng : numpy.random.Generator or int, optional
+        Random generator or seed of the noise.
+    correct_damping : bool, optional
+        Use the undamped frequencies and exact damping ratios instead of the thesis's approximations.
+    fs : float, optional
+        Sampling rate of the records (Hz).
+    duration : float, optional
+        Length of each record (s).
 
     Returns
     -------

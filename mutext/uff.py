@@ -217,6 +217,11 @@ def parse_units(label) -> Units:
     ``·`` or a blank multiply, ``/`` divides (left to right:
     ``m/s/N`` is ``(m/s)/N``), parentheses group.  Known units: :data:`KNOWN_UNITS`.
 
+    Parameters
+    ----------
+    label : str
+        The units label.
+
     Raises
     ------
     ValueError
@@ -369,7 +374,13 @@ def _err(path, n, fld, problem):
 
 def is_uff_file(path) -> bool:
     """Whether ``path`` is to be read as a Universal File: extension ``.uff``/``.unv`` or content
-    starting with a ``    -1`` delimiter line."""
+    starting with a ``    -1`` delimiter line.
+
+    Parameters
+    ----------
+    path : str or path-like
+        The file.
+    """
     p = Path(path)
     if p.suffix.lower() in (".uff", ".unv"):
         return True
