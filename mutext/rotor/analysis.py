@@ -119,7 +119,13 @@ class Modes:
     dof_names: list = field(default_factory=list)
 
     def whirl_direction(self, threshold: float = 0.5) -> list[str]:
-        """``"forward"``, ``"backward"`` or ``"mixed"`` per mode (``""`` when not a rotor)."""
+        """``"forward"``, ``"backward"`` or ``"mixed"`` per mode (``""`` when not a rotor).
+
+        Parameters
+        ----------
+        threshold : float, optional
+            Whirl index above which a mode is forward (below minus it, backward).
+        """
         return [whirl_label(w, threshold) for w in self.whirl]
 
 
@@ -137,7 +143,17 @@ FRF = FRFMatrix
 
 @dataclass
 class Campbell:
-    """Campbell diagram data: ``frequencies_hz[i, r]`` and ``whirl[i, r]`` at ``speeds[i]`` [rad/s]."""
+    """Campbell diagram data: ``frequencies_hz[i, r]`` and ``whirl[i, r]`` at ``speeds[i]`` [rad/s].
+
+    Attributes
+    ----------
+    speeds : (S,) ndarray
+        Spin speeds [rad/s].
+    frequencies_hz : (S, n) ndarray
+        Natural frequencies [Hz] of the ``n`` lowest modes at each speed (NaN where fewer).
+    whirl : (S, n) ndarray
+        Their whirl indices (+1 forward, -1 backward).
+    """
     speeds: np.ndarray
     frequencies_hz: np.ndarray
     whirl: np.ndarray
@@ -148,7 +164,15 @@ class Campbell:
 
 
 def whirl_index(shape: np.ndarray, layout) -> float:
-    """Whirl index of one mode shape (see the module docstring); NaN unless a two-plane rotor."""
+    """Whirl index of one mode shape (see the module docstring); NaN unless a two-plane rotor.
+
+    Parameters
+    ----------
+    shape : (ndof,) complex ndarray
+        Mode shape (displacement part of the eigenvector).
+    layout : Layout
+        The model's DOF numbering.
+    """
     if layout.kind != "rotor":
         return float("nan")
     u = shape[0::4]
@@ -337,7 +361,31 @@ def _divergence(model, rates) -> str:
 
 def natural_frequencies(model, *, speed: float | None = None, values=None, n: int | None = None,
                         matrices=None) -> np.ndarray:
-    """Damped natural frequencies [Hz] (rigid-body modes left out), lowest first."""
+    """Damped natural frequencies [Hz] (rigid-body modes left out), lowest first.
+
+    Parameters
+    ----------
+    model : Structure or Rotor
+        The assembled model, e.g. from :func:`mutext.rotor.load_model`.
+    speed : float, optional
+        Spin speed [rad/s]; default ``model.speed`` (0 for non-rotors).
+    values : mapping or array_like, optional
+        Parameter values: a mapping ``name -> value`` (SI) overriding nominal ones, or a full
+        vector in the order of ``parameters`` (default: nominal, see :meth:`Structure.values`).
+
+    n : int, optional
+        Keep the ``n`` lowest modes.
+    matrices : Matrices, optional
+        Precomputed ``model.matrices(values)``.
+
+    Examples
+    --------
+    >>> from mutext.rotor import data_path, load_model
+    >>> from mutext.rotor.analysis import natural_frequencies
+    >>> f = natural_frequencies(load_model(data_path("three_mass.toml")))
+    >>> f.size, bool(f[0] < f[1] < f[2])            # three carts, three modes [Hz]
+    (3, True)
+    """
     return modes(model, speed=speed, values=values, n=n, matrices=matrices).frequencies_hz
 
 
@@ -346,6 +394,19 @@ def campbell(model, speeds: Sequence[float], *, n: int = 6, values=None) -> Camp
 
     The matrices are evaluated once; modes are sorted by frequency at each
     speed (no mode tracking across crossings).
+
+    Parameters
+    ----------
+    model : Structure or Rotor
+        The assembled model, e.g. from :func:`mutext.rotor.load_model`.
+
+    speeds : sequence of float
+        Spin speeds [rad/s].
+    n : int, optional
+        Number of modes per speed.
+    values : mapping or array_like, optional
+        Parameter values: a mapping ``name -> value`` (SI) overriding nominal ones, or a full
+        vector in the order of ``parameters`` (default: nominal, see :meth:`Structure.values`).
     """
     try:
         speeds = np.atleast_1d(np.asarray(speeds, dtype=float))
@@ -389,6 +450,21 @@ def frf(model, freqs_hz, *, inputs: Sequence[str] | None = None, outputs: Sequen
     Default ports: all inputs and outputs of the model.  Returns an
     :class:`mutext.response.FRFMatrix` with ``H`` of shape
     ``(noutputs, ninputs, nfreq)`` in output units per input unit.
+
+    Parameters
+    ----------
+    model : Structure or Rotor
+        The assembled model, e.g. from :func:`mutext.rotor.load_model`.
+
+    freqs_hz : array_like
+        Frequencies [Hz].
+    inputs, outputs : sequence of str, optional
+        Names of the input and output ports (default: all of the model's).
+    speed : float, optional
+        Spin speed [rad/s]; default ``model.speed`` (0 for non-rotors).
+    values : mapping or array_like, optional
+        Parameter values: a mapping ``name -> value`` (SI) overriding nominal ones, or a full
+        vector in the order of ``parameters`` (default: nominal, see :meth:`Structure.values`).
 
     Examples
     --------
@@ -470,6 +546,18 @@ def state_space(model, *, inputs: Sequence[str] | None = None, outputs: Sequence
 
     State :math:`x = [q; \\dot q]` (SI); inputs in N, N m or A (exciter
     currents, through the force per ampere); outputs in m or rad.
+
+    Parameters
+    ----------
+    model : Structure or Rotor
+        The assembled model, e.g. from :func:`mutext.rotor.load_model`.
+    inputs, outputs : sequence of str, optional
+        Names of the input and output ports (default: all of the model's).
+    speed : float, optional
+        Spin speed [rad/s]; default ``model.speed`` (0 for non-rotors).
+    values : mapping or array_like, optional
+        Parameter values: a mapping ``name -> value`` (SI) overriding nominal ones, or a full
+        vector in the order of ``parameters`` (default: nominal, see :meth:`Structure.values`).
     """
     speed = _speed(model, speed)
     ins, outs = _ports(model, inputs, outputs)

@@ -36,6 +36,13 @@ SUPPORTS = ("pinned", "cantilever", "free")
 def beta_l(support: str, mode: int) -> float:
     r""":math:`\beta_n L` of Euler-Bernoulli mode ``mode`` (1-based) of a beam with ``support``.
 
+    Parameters
+    ----------
+    support : str
+        One of :data:`SUPPORTS` (``"pinned"``, ``"cantilever"``, ``"free"``, ...).
+    mode : int
+        1-based mode number.
+
     Examples
     --------
     >>> from mutext.rotor.analytic import beta_l
@@ -82,6 +89,25 @@ def timoshenko_pinned_frequency(mode: int, length: float, E: float, G: float, rh
     ``G`` is the shear modulus [Pa] and ``kappa`` the shear coefficient
     (:func:`mutext.rotor.elements.cowper_shear_coefficient`); the other
     arguments as in :func:`euler_bernoulli_frequency`.
+
+    Parameters
+    ----------
+    mode : int
+        1-based mode number.
+    length : float
+        Beam length [m].
+    E : float
+        Young's modulus [Pa].
+    G : float
+        Shear modulus [Pa].
+    rho : float
+        Density [kg/m^3].
+    A : float
+        Cross-section area [m^2].
+    I : float
+        Second moment of area [m^4].
+    kappa : float
+        Shear coefficient.
 
     Examples
     --------

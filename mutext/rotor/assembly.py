@@ -71,6 +71,17 @@ class Matrices(NamedTuple):
 
     ``C`` is the non-rotating damping (discrete dampers, proportional and
     modal damping); the rotating system's velocity matrix is ``C + speed * G``.
+
+    Attributes
+    ----------
+    M : (ndof, ndof) ndarray
+        Mass matrix [kg, kg m^2].
+    C : (ndof, ndof) ndarray
+        Non-rotating damping matrix [N s/m].
+    K : (ndof, ndof) ndarray
+        Stiffness matrix [N/m].
+    G : (ndof, ndof) ndarray
+        Gyroscopic matrix per unit speed (multiplied by the speed in rad/s).
     """
     M: np.ndarray
     C: np.ndarray
@@ -86,6 +97,13 @@ class ProportionalDamping:
     ``damping.alpha`` and ``damping.beta`` (symbolic, like all others).
     A mode of frequency :math:`\omega` gets the damping ratio
     :math:`\zeta = \alpha/(2\omega) + \beta\omega/2`.
+
+    Attributes
+    ----------
+    alpha : float
+        Mass-proportional coefficient [1/s].
+    beta : float
+        Stiffness-proportional coefficient [s].
     """
     alpha: float = 0.0
     beta: float = 0.0
@@ -101,6 +119,11 @@ class ModalDamping:
     evaluated parameters (rigid-body modes get none).  It depends on the
     eigenvectors, so it is added numerically by :meth:`Structure.matrices`
     and is *not* part of the symbolic function ``C(p)``.
+
+    Attributes
+    ----------
+    ratio : float
+        Damping ratio of every mode (0.01 is 1 %).
     """
     ratio: float = 0.01
 
@@ -273,7 +296,13 @@ class Structure:
         return self.layout.dof_names
 
     def parameter(self, name: str) -> Param:
-        """The :class:`Param` called ``name``."""
+        """The :class:`Param` called ``name``.
+
+        Parameters
+        ----------
+        name : str
+            Parameter name (e.g. ``"bearing1.k"``).
+        """
         return self.parameters[self._lookup(name)]
 
     def _lookup(self, name: str) -> int:
@@ -289,6 +318,11 @@ class Structure:
 
         ``values`` is ``None``, a mapping ``name -> value`` (SI) overriding some
         nominal values, or a full vector in the order of :attr:`parameters`.
+
+        Parameters
+        ----------
+        values : mapping, array_like or None, optional
+            Overrides of nominal values by name, or the full vector.
         """
         if values is None:
             return self.nominal.copy()
@@ -335,7 +369,14 @@ class Structure:
 
     # ------------------------------------------------------------------ numeric
     def evaluate(self, values=None):
-        """``(M, C, K, G, B)`` as numpy arrays at ``values``, without modal damping."""
+        """``(M, C, K, G, B)`` as numpy arrays at ``values``, without modal damping.
+
+        Parameters
+        ----------
+        values : mapping or array_like, optional
+            Parameter values: a mapping ``name -> value`` (SI) overriding nominal ones, or a full
+            vector in the order of ``parameters`` (default: nominal, see :meth:`Structure.values`).
+        """
         out = self._all(self.values(values))
         return tuple(np.asarray(x.full()) for x in out)
 
@@ -343,6 +384,12 @@ class Structure:
         """Numeric ``Matrices(M, C, K, G)`` [SI] at ``values`` (default: nominal).
 
         ``C`` includes modal damping if the model has :class:`ModalDamping`.
+
+        Parameters
+        ----------
+        values : mapping or array_like, optional
+            Parameter values: a mapping ``name -> value`` (SI) overriding nominal ones, or a full
+            vector in the order of ``parameters`` (default: nominal, see :meth:`Structure.values`).
         """
         v = self.values(values)
         M, C, K, G, _ = self.evaluate(v)
@@ -354,7 +401,14 @@ class Structure:
         return Matrices(M, C, K, G)
 
     def input_matrix(self, values=None) -> np.ndarray:
-        """``B`` (``ndof x ninputs``): column j is the generalized force of a unit input j."""
+        """``B`` (``ndof x ninputs``): column j is the generalized force of a unit input j.
+
+        Parameters
+        ----------
+        values : mapping or array_like, optional
+            Parameter values: a mapping ``name -> value`` (SI) overriding nominal ones, or a full
+            vector in the order of ``parameters`` (default: nominal, see :meth:`Structure.values`).
+        """
         return np.asarray(self.functions["B"](self.values(values)).full())
 
     def output_matrix(self) -> np.ndarray:
@@ -366,22 +420,48 @@ class Structure:
 
     # ------------------------------------------------------------------ analysis shortcuts
     def modes(self, **kw):
-        """See :func:`mutext.rotor.analysis.modes`."""
+        """See :func:`mutext.rotor.analysis.modes`.
+
+        Parameters
+        ----------
+        **kw
+            Keyword arguments of the function referred to.
+        """
         from .analysis import modes
         return modes(self, **kw)
 
     def natural_frequencies(self, **kw) -> np.ndarray:
-        """See :func:`mutext.rotor.analysis.natural_frequencies` (Hz)."""
+        """See :func:`mutext.rotor.analysis.natural_frequencies` (Hz).
+
+        Parameters
+        ----------
+        **kw
+            Keyword arguments of the function referred to.
+        """
         from .analysis import natural_frequencies
         return natural_frequencies(self, **kw)
 
     def frf(self, freqs_hz, **kw):
-        """See :func:`mutext.rotor.analysis.frf`."""
+        """See :func:`mutext.rotor.analysis.frf`.
+
+        Parameters
+        ----------
+        freqs_hz : array_like
+            Frequencies [Hz].
+        **kw
+            Keyword arguments of the function referred to.
+        """
         from .analysis import frf
         return frf(self, freqs_hz, **kw)
 
     def state_space(self, **kw):
-        """See :func:`mutext.rotor.analysis.state_space`."""
+        """See :func:`mutext.rotor.analysis.state_space`.
+
+        Parameters
+        ----------
+        **kw
+            Keyword arguments of the function referred to.
+        """
         from .analysis import state_space
         return state_space(self, **kw)
 
@@ -396,6 +476,15 @@ def modal_damping_matrix(M: np.ndarray, K: np.ndarray, ratio: float) -> np.ndarr
 
     Modes with :math:`\omega_r^2 \le 10^{-12}\max\omega^2` (rigid-body or
     unstable) get no damping.
+
+    Parameters
+    ----------
+    M : (ndof, ndof) ndarray
+        Mass matrix (symmetric positive definite).
+    K : (ndof, ndof) ndarray
+        Stiffness matrix (its symmetric part is used).
+    ratio : float
+        Damping ratio of every mode.
     """
     import scipy.linalg as sla
 
@@ -466,7 +555,13 @@ class Rotor(Structure):
         return self.layout.n_nodes
 
     def shaft_element(self, station: int) -> ShaftElement:
-        """The shaft element that starts at ``station`` (1-based)."""
+        """The shaft element that starts at ``station`` (1-based).
+
+        Parameters
+        ----------
+        station : int
+            1-based station where the element starts.
+        """
         try:
             return self._shafts[station]
         except KeyError:
@@ -474,7 +569,15 @@ class Rotor(Structure):
                              f"(stations with one: {sorted(self._shafts)[:3]}...)") from None
 
     def campbell(self, speeds, **kw):
-        """See :func:`mutext.rotor.analysis.campbell`."""
+        """See :func:`mutext.rotor.analysis.campbell`.
+
+        Parameters
+        ----------
+        speeds : sequence of float
+            Spin speeds [rad/s].
+        **kw
+            Keyword arguments of the function referred to.
+        """
         from .analysis import campbell
         return campbell(self, speeds, **kw)
 
@@ -502,6 +605,17 @@ def shaft_stiffness_with_compliance(shaft: ShaftElement, p, c_rot, xi=0.0):
     node-2 forces to all four nodal forces.  ``c_rot = 0`` returns the intact
     matrix.  ``p`` maps parameter names to symbols; ``c_rot`` and ``xi`` are
     CasADi expressions or floats.
+
+    Parameters
+    ----------
+    shaft : ShaftElement
+        The host element.
+    p : mapping of str to casadi.SX
+        Parameter name -> symbol.
+    c_rot : casadi.SX or float
+        Rotational compliance of the hinge [rad/(N m)].
+    xi : casadi.SX or float, optional
+        Position of the hinge, 0 (first node) to 1 (second node).
     """
     Mt, Mr, K0 = shaft.plane_matrices(p)
     L = shaft.sym(p, "L")
@@ -537,6 +651,9 @@ class ShaftFlexibility(Element):
         Compliance in the y-z plane (default: the same parameter as ``c_x``).
     xi : float
         Position of the hinge in the element, 0 (at ``station``) to 1.
+    name : str, optional
+        Name of the element (default: its kind and station, e.g. ``"flexibility3"``); parameters
+        without a :class:`Param` are called ``"<name>.<field>"``.
     """
     KIND = "flexibility"
     FIELDS = {"c_x": ("rad/(N m)", "rotational compliance, x-z plane"),
@@ -553,11 +670,27 @@ class ShaftFlexibility(Element):
         self.host: ShaftElement | None = None
 
     def bind(self, structure):
+        """Find the host shaft element (the one starting at ``station``) in ``structure``.
+
+        Parameters
+        ----------
+        structure : Rotor
+            The structure the element is part of.
+        """
         if not isinstance(structure, Rotor):
             raise ModelError(f"{self.name}: a shaft flexibility needs a Rotor")
         self.host = structure.shaft_element(self.nodes[0])
 
     def plane_delta(self, p, c):
+        """Plane (4x4) stiffness change of the host element for the compliance ``c``.
+
+        Parameters
+        ----------
+        p : mapping of str to casadi.SX
+            Parameter name -> symbol.
+        c : casadi.SX or float
+            Rotational compliance of the hinge [rad/(N m)].
+        """
         K0 = self.host.plane_matrices(p)[2]
         return shaft_stiffness_with_compliance(self.host, p, c, self.xi) - K0
 

@@ -33,6 +33,9 @@ class BearingElement(Element):
         Damping [N s/m] (x, and y unless ``cyy`` is given).
     kyy, cyy : float or Param, optional
         Stiffness and damping in y for an anisotropic bearing.
+    name : str, optional
+        Name of the element (default: its kind and station, e.g. ``"bearing3"``); parameters
+        without a :class:`Param` are called ``"<name>.<field>"``.
     """
     KIND = "bearing"
     FIELDS = {"k": ("N/m", "bearing stiffness"), "c": ("N s/m", "bearing damping"),

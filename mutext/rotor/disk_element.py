@@ -37,6 +37,9 @@ class DiskElement(Element):
         Mass [kg].
     Ip, Id : float or Param
         Polar and diametral (transverse) moments of inertia [kg m^2].
+    name : str, optional
+        Name of the element (default: its kind and station, e.g. ``"disk3"``); parameters
+        without a :class:`Param` are called ``"<name>.<field>"``.
     """
     KIND = "disk"
     FIELDS = {"m": ("kg", "mass"), "Ip": ("kg m^2", "polar moment of inertia"),
@@ -50,7 +53,22 @@ class DiskElement(Element):
     def from_geometry(cls, station: int, width: float, do: float, di: float, rho: float, *,
                       name: str | None = None) -> "DiskElement":
         r"""Disk of uniform density: :math:`m = \rho\pi(d_o^2-d_i^2)h/4`,
-        :math:`I_p = m(d_o^2+d_i^2)/8`, :math:`I_d = I_p/2 + m h^2/12` (SI)."""
+        :math:`I_p = m(d_o^2+d_i^2)/8`, :math:`I_d = I_p/2 + m h^2/12` (SI).
+
+        Parameters
+        ----------
+        station : int
+            1-based station of the disk.
+        width : float
+            Axial width h [m].
+        do, di : float
+            Outer and inner (bore) diameters [m].
+        rho : float
+            Density [kg/m^3].
+        name : str, optional
+            Name of the element (default: its kind and station, e.g. ``"disk3"``); parameters
+            without a :class:`Param` are called ``"<name>.<field>"``.
+        """
         if not (width > 0 and do > 0 and 0 <= di < do and rho > 0):
             raise ModelError(f"disk at station {station}: need width > 0, 0 <= di < do and rho > 0, got "
                              f"width={width}, do={do}, di={di}, rho={rho}")
@@ -79,7 +97,18 @@ class DiskElement(Element):
 
 
 class PointMass(DiskElement):
-    """A lumped mass [kg] without rotary inertia (for lumped chains; in a rotor: mass in x and y only)."""
+    """A lumped mass [kg] without rotary inertia (for lumped chains; in a rotor: mass in x and y only).
+
+    Parameters
+    ----------
+    node : int
+        1-based station or mass number.
+    m : float or Param
+        Mass [kg].
+    name : str, optional
+        Name of the element (default: its kind and station, e.g. ``"mass3"``); parameters
+        without a :class:`Param` are called ``"<name>.<field>"``.
+    """
     KIND = "mass"
     FIELDS = {"m": ("kg", "mass")}
 

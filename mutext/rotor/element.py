@@ -31,6 +31,17 @@ class Param:
 
     Pass the same :class:`Param` to several elements to make them share one
     symbol (e.g. one density for the whole shaft, tuned once).
+
+    Attributes
+    ----------
+    name : str
+        Name of the parameter (e.g. ``"shaft.E"``, ``"bearing1.k"``).
+    value : float
+        Nominal value (SI).
+    unit : str
+        Unit, for reports.
+    doc : str
+        What the parameter is, for reports.
     """
     name: str
     value: float
@@ -51,6 +62,18 @@ class ParameterSet:
         self.symbols: dict[str, ca.SX] = {}
 
     def add(self, param: Param) -> str:
+        """Register ``param`` (once per name) and create its CasADi symbol.
+
+        Parameters
+        ----------
+        param : Param
+            The parameter; a second one of the same name must have the same nominal value.
+
+        Returns
+        -------
+        str
+            The parameter's name.
+        """
         if not isinstance(param.name, str) or not param.name:
             raise ModelError(f"a parameter needs a non-empty name, got {param.name!r}")
         v = param.value
@@ -120,6 +143,13 @@ class Layout:
         self.node_names = names
 
     def label(self, label: str) -> str:
+        """The layout's own name of a DOF label (aliases resolved); raises for a label the layout lacks.
+
+        Parameters
+        ----------
+        label : str
+            A DOF label or one of its aliases (``"x"`` for ``"u"``, ``"y"`` for ``"v"``).
+        """
         lab = self.ALIASES[self.kind].get(label, label)
         if lab not in self.labels:
             raise ModelError(f"direction '{label}' does not exist in a '{self.kind}' model "
@@ -127,16 +157,40 @@ class Layout:
         return lab
 
     def check_node(self, node: int, what: str = "node") -> int:
+        """``node`` if it lies in 1..n_nodes, else :class:`~mutext.errors.ModelError`.
+
+        Parameters
+        ----------
+        node : int
+            1-based node number.
+        what : str, optional
+            Name of the caller in the error message.
+        """
         if isinstance(node, bool) or not isinstance(node, int) or not 1 <= node <= self.n_nodes:
             raise ModelError(f"{what}: station/node {node!r} is outside 1..{self.n_nodes}")
         return node
 
     def dof(self, node: int, label: str) -> int:
-        """0-based global index of DOF ``label`` at 1-based ``node``."""
+        """0-based global index of DOF ``label`` at 1-based ``node``.
+
+        Parameters
+        ----------
+        node : int
+            1-based node number.
+        label : str
+            DOF label (or alias) at the node.
+        """
         self.check_node(node)
         return (node - 1) * self.per_node + self.labels.index(self.label(label))
 
     def node_dofs(self, node: int) -> list[int]:
+        """0-based global indices of all DOFs of ``node``.
+
+        Parameters
+        ----------
+        node : int
+            1-based node number.
+        """
         self.check_node(node)
         return list(range((node - 1) * self.per_node, node * self.per_node))
 
@@ -153,6 +207,19 @@ class InputPort:
 
     ``gain`` is a parameter name (e.g. an exciter's force per ampere) or
     ``None`` for a unit force [N] / moment [N m].  ``unit`` is the unit of the input.
+
+    Attributes
+    ----------
+    name : str
+        Name of the port.
+    node : int
+        1-based station (node).
+    direction : str
+        DOF label at the node (``"u"``/``"x"``, ``"v"``/``"y"``, ``"theta"``, ``"psi"``).
+    gain : str or None
+        Name of the parameter multiplying the input, or None.
+    unit : str
+        Unit of the input (``"N"``, ``"N m"``, ``"A"``).
     """
     name: str
     node: int
@@ -163,7 +230,19 @@ class InputPort:
 
 @dataclass(frozen=True)
 class OutputPort:
-    """A named output: the displacement [m] or rotation [rad] of one DOF."""
+    """A named output: the displacement [m] or rotation [rad] of one DOF.
+
+    Attributes
+    ----------
+    name : str
+        Name of the port.
+    node : int
+        1-based station (node).
+    direction : str
+        DOF label at the node (``"u"``/``"x"``, ``"v"``/``"y"``, ``"theta"``, ``"psi"``).
+    unit : str
+        Unit of the output (``"m"`` or ``"rad"``).
+    """
     name: str
     node: int
     direction: str = "u"
@@ -190,6 +269,16 @@ class Element:
     An element may also define ``bind(structure)``, called by the assembly
     before any matrix is built (e.g. to find the shaft element it modifies),
     and ``input_ports()`` returning :class:`InputPort` objects.
+
+    Parameters
+    ----------
+    nodes : sequence of int
+        1-based station (node) numbers the element occupies.
+    name : str, optional
+        Name of the element (default: its ``KIND`` and first node, e.g. ``"bearing3"``).
+    **values
+        One value per field of ``FIELDS``: a number (SI) or a :class:`Param` shared
+        with other elements; ``None`` leaves the field out.
     """
     KIND = "element"
     FIELDS: dict[str, tuple[str, str]] = {}
@@ -219,11 +308,24 @@ class Element:
 
     # -- parameters
     def nominal(self, field: str) -> float:
+        """Nominal value (SI) of one of the element's fields.
+
+        Parameters
+        ----------
+        field : str
+            A field of ``FIELDS`` given to the element.
+        """
         v = self.values[field]
         return v.value if isinstance(v, Param) else float(v)
 
     def declare(self, params: ParameterSet) -> None:
-        """Register the element's parameters in ``params``."""
+        """Register the element's parameters in ``params``.
+
+        Parameters
+        ----------
+        params : ParameterSet
+            The structure's parameters.
+        """
         for f, v in self.values.items():
             unit, doc = self.FIELDS[f]
             if isinstance(v, Param):
@@ -233,33 +335,106 @@ class Element:
             self._pnames[f] = params.add(par)
 
     def param_name(self, field: str) -> str:
+        """Name of the structure parameter behind ``field`` (after :meth:`declare`).
+
+        Parameters
+        ----------
+        field : str
+            A field of ``FIELDS`` given to the element.
+        """
         return self._pnames[field]
 
     def has(self, field: str) -> bool:
+        """Whether the element was given a value for ``field``.
+
+        Parameters
+        ----------
+        field : str
+            A field of ``FIELDS``.
+        """
         return field in self.values
 
     def sym(self, p: Mapping[str, ca.SX], field: str) -> ca.SX:
+        """The CasADi symbol of one of the element's fields.
+
+        Parameters
+        ----------
+        p : mapping of str to casadi.SX
+            Parameter name -> symbol.
+        field : str
+            A field of ``FIELDS`` given to the element.
+        """
         return p[self._pnames[field]]
 
     # -- topology
     def check(self, layout: Layout) -> None:
+        """Raise :class:`~mutext.errors.ModelError` if a node of the element is not in ``layout``.
+
+        Parameters
+        ----------
+        layout : Layout
+            The DOF numbering of the structure.
+        """
         for n in self.nodes:
             layout.check_node(n, f"{self.name}")
 
     def dofs(self, layout: Layout) -> list[int]:
+        """0-based global DOFs of the element's local matrices (default: all DOFs of its nodes).
+
+        Parameters
+        ----------
+        layout : Layout
+            The DOF numbering of the structure.
+        """
         return [d for n in self.nodes for d in layout.node_dofs(n)]
 
     # -- matrices (override)
     def mass_matrix(self, p, layout):
+        """Local mass matrix (CasADi ``SX``, ``len(dofs) x len(dofs)``) or None.
+
+        Parameters
+        ----------
+        p : mapping of str to casadi.SX
+            Parameter name -> symbol (the structure's symbols; see :meth:`Element.sym`).
+        layout : Layout
+            The DOF numbering of the structure.
+        """
         return None
 
     def damping_matrix(self, p, layout):
+        """Local damping matrix (CasADi ``SX``, ``len(dofs) x len(dofs)``) or None.
+
+        Parameters
+        ----------
+        p : mapping of str to casadi.SX
+            Parameter name -> symbol (the structure's symbols; see :meth:`Element.sym`).
+        layout : Layout
+            The DOF numbering of the structure.
+        """
         return None
 
     def stiffness_matrix(self, p, layout):
+        """Local stiffness matrix (CasADi ``SX``, ``len(dofs) x len(dofs)``) or None.
+
+        Parameters
+        ----------
+        p : mapping of str to casadi.SX
+            Parameter name -> symbol (the structure's symbols; see :meth:`Element.sym`).
+        layout : Layout
+            The DOF numbering of the structure.
+        """
         return None
 
     def gyroscopic_matrix(self, p, layout):
+        """Local gyroscopic matrix per unit speed (CasADi ``SX``) or None.
+
+        Parameters
+        ----------
+        p : mapping of str to casadi.SX
+            Parameter name -> symbol (the structure's symbols; see :meth:`Element.sym`).
+        layout : Layout
+            The DOF numbering of the structure.
+        """
         return None
 
     def input_ports(self) -> list[InputPort]:

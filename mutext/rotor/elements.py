@@ -108,6 +108,15 @@ class StructuralDamping(Element):
     element spans all nodes and reads the other elements of its structure
     when bound; its parameters are ``"<name>.alpha"`` and ``"<name>.beta"``
     (``"damping.alpha"``, ``"damping.beta"``).
+
+    Parameters
+    ----------
+    alpha : float or Param, optional
+        Mass-proportional coefficient [1/s].
+    beta : float or Param, optional
+        Coefficient of the members' stiffness [s].
+    name : str, optional
+        Name of the element and prefix of its parameters.
     """
     KIND = "damping"
     FIELDS = {"alpha": ("1/s", "mass-proportional damping coefficient"),
@@ -119,11 +128,24 @@ class StructuralDamping(Element):
         self.members: list = []
 
     def bind(self, structure):
+        """Collect the other elements of ``structure`` (its members are read when the matrix is built).
+
+        Parameters
+        ----------
+        structure : Structure
+            The structure the element is part of.
+        """
         self.members = [el for el in structure.elements if el is not self]
 
     @staticmethod
     def grounded(el) -> bool:
-        """True for a connection to ground (no stiffness-proportional damping)."""
+        """True for a connection to ground (no stiffness-proportional damping).
+
+        Parameters
+        ----------
+        el : Element
+            An element of the structure.
+        """
         return isinstance(el, (BearingElement, ExciterElement)) or (isinstance(el, Spring) and len(el.nodes) == 1)
 
     def dofs(self, layout):

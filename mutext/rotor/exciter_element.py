@@ -29,6 +29,9 @@ class ExciterElement(Element):
         ``"u"``/``"x"`` (default) or ``"v"``/``"y"``.
     port : str, optional
         Input name (default ``"i<station>"``).
+    name : str, optional
+        Name of the element (default: its kind and station, e.g. ``"exciter3"``); parameters
+        without a :class:`Param` are called ``"<name>.<field>"``.
     """
     KIND = "exciter"
     FIELDS = {"ki": ("N/A", "force per ampere"), "kx": ("N/m", "negative stiffness")}

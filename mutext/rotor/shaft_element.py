@@ -40,6 +40,11 @@ def section_properties(do, di):
     .. math:: A = \frac{\pi}{4}(d_o^2 - d_i^2),\qquad I = \frac{\pi}{64}(d_o^4 - d_i^4)
 
     Diameters in m; returns ``(A [m^2], I [m^4])``.  Works on floats and CasADi expressions.
+
+    Parameters
+    ----------
+    do, di : float or casadi.SX
+        Outer and inner diameters [m] (``di = 0`` for a solid section).
     """
     return math.pi / 4.0 * (do**2 - di**2), math.pi / 64.0 * (do**4 - di**4)
 
@@ -53,6 +58,13 @@ def cowper_shear_coefficient(nu, do=None, di=None):
 
     which for a solid section (:math:`m = 0`) is Friswell's
     :math:`\kappa = 6(1+\nu)/(7+6\nu)` ([Fri]_ ch. 5).
+
+    Parameters
+    ----------
+    nu : float
+        Poisson's ratio.
+    do, di : float, optional
+        Outer and inner diameters [m]; without them the solid-section formula.
     """
     if do is None or di is None:
         return 6.0 * (1.0 + nu) / (7.0 + 6.0 * nu)
@@ -98,6 +110,24 @@ def timoshenko_plane_matrices(E, G, rho, L, do, di, kappa, shear=True):
     rotary inertia (Rayleigh beam); drop ``Mr`` too for Euler-Bernoulli.
 
     Parameters are SI (Pa, Pa, kg/m^3, m, m, m, -); floats or CasADi expressions.
+
+    Parameters
+    ----------
+    E : float or casadi.SX
+        Young's modulus [Pa].
+    G : float or casadi.SX
+        Shear modulus [Pa].
+    rho : float or casadi.SX
+        Density [kg/m^3].
+    L : float or casadi.SX
+        Element length [m].
+    do, di : float or casadi.SX
+        Outer and inner diameters [m].
+    kappa : float or casadi.SX
+        Shear coefficient (:func:`cowper_shear_coefficient`).
+    shear : bool, optional
+        Include shear deformation; False gives the Euler-Bernoulli element
+        (:math:`\Phi = 0`).
     """
     A, I = section_properties(do, di)
     phi = 12.0 * E * I / (kappa * G * A * L**2) if shear else 0.0
@@ -150,6 +180,15 @@ def timoshenko_shape_functions(xi, L, phi):
         P_2 = \frac{1 - 4\xi + 3\xi^2 + \Phi(1-\xi)}{1+\Phi},\ 
         P_3 = -P_1,\ 
         P_4 = \frac{-2\xi + 3\xi^2 + \Phi\xi}{1+\Phi}.
+
+    Parameters
+    ----------
+    xi : float or casadi.SX
+        Position along the element, 0 at the first node and 1 at the second.
+    L : float or casadi.SX
+        Element length [m].
+    phi : float or casadi.SX
+        Shear parameter :math:`\Phi = 12EI/(\kappa G A L^2)` (0: Euler-Bernoulli).
     """
     d = 1.0 + phi
     N = [(1 - 3 * xi**2 + 2 * xi**3 + phi * (1 - xi)) / d,
@@ -178,7 +217,15 @@ T_YZ = _selector(4, 8, [(0, 1, 1.0), (1, 2, -1.0), (2, 5, 1.0), (3, 6, -1.0)])
 
 
 def plane_to_rotor(Mxz, Myz=None):
-    r"""Two-plane (8x8) matrix from plane (4x4) matrices: :math:`T_{xz}^T M_{xz} T_{xz} + T_{yz}^T M_{yz} T_{yz}`."""
+    r"""Two-plane (8x8) matrix from plane (4x4) matrices: :math:`T_{xz}^T M_{xz} T_{xz} + T_{yz}^T M_{yz} T_{yz}`.
+
+    Parameters
+    ----------
+    Mxz : (4, 4) casadi.SX or array_like
+        Plane matrix acting in the x-z plane.
+    Myz : (4, 4) casadi.SX or array_like, optional
+        Plane matrix acting in the y-z plane (default: ``Mxz``).
+    """
     Myz = Mxz if Myz is None else Myz
     return ca.mtimes([T_XZ.T, Mxz, T_XZ]) + ca.mtimes([T_YZ.T, Myz, T_YZ])
 
@@ -224,6 +271,9 @@ class ShaftElement(Element):
     rotary_inertia : bool
         False drops :math:`M_r` from the mass matrix (and the gyroscopic
         matrix); with ``shear=False`` this is the Euler-Bernoulli element.
+    name : str, optional
+        Name of the element (default: its kind and station, e.g. ``"shaft3"``); parameters
+        without a :class:`Param` are called ``"<name>.<field>"``.
     """
     KIND = "shaft"
     FIELDS = {
@@ -255,7 +305,13 @@ class ShaftElement(Element):
             raise ModelError(f"{self.name}.nu must be in (-1, 0.5), got {self.nominal('nu'):g}")
 
     def plane_matrices(self, p):
-        """``(Mt, Mr, K)`` of :func:`timoshenko_plane_matrices` for this element."""
+        """``(Mt, Mr, K)`` of :func:`timoshenko_plane_matrices` for this element.
+
+        Parameters
+        ----------
+        p : mapping of str to casadi.SX
+            Parameter name -> symbol.
+        """
         E, rho, L = self.sym(p, "E"), self.sym(p, "rho"), self.sym(p, "L")
         do, di = self.sym(p, "do"), self.sym(p, "di")
         if self.has("G"):

@@ -40,6 +40,24 @@ def sparse_modes(model, speed: float | None = None, n: int = 6, *, values=None, 
     overdamped roots are left out by the test of :mod:`mutext.rotor.analysis`.  A model
     with rigid-body modes makes :math:`A` singular: give a nonzero ``shift_hz`` then.
 
+    Parameters
+    ----------
+    model : Structure or Rotor
+        The assembled model, e.g. from :func:`mutext.rotor.load_model`.
+    speed : float, optional
+        Spin speed [rad/s]; default ``model.speed`` (0 for non-rotors).
+
+    n : int, optional
+        Number of modes.
+    values : mapping or array_like, optional
+        Parameter values: a mapping ``name -> value`` (SI) overriding nominal ones, or a full
+        vector in the order of ``parameters`` (default: nominal, see :meth:`Structure.values`).
+
+    shift_hz : float, optional
+        Frequency [Hz] around which the modes are sought (0: the slowest).
+    extra : int, optional
+        Eigenvalues computed beyond ``2 n`` (margin for overdamped roots).
+
     Returns
     -------
     mutext.rotor.analysis.Modes

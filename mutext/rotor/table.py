@@ -115,7 +115,17 @@ class Station:
 
 @dataclass
 class StationTable:
-    """An ordered list of :class:`Station` (SI units) with its origin."""
+    """An ordered list of :class:`Station` (SI units) with its origin.
+
+    Attributes
+    ----------
+    stations : list of Station
+        The stations, in order.
+    source : str
+        Where the table was read from (file name), for messages.
+    comments : list of str
+        Comment lines of the file.
+    """
     stations: list[Station]
     source: str = "<table>"
     comments: list[str] = field(default_factory=list)
@@ -143,7 +153,13 @@ class StationTable:
         return float(sum(s.length for s in self.stations))
 
     def flagged(self, flag: str) -> list[int]:
-        """Station numbers whose ``flag`` (one of :data:`FLAGS`) is set."""
+        """Station numbers whose ``flag`` (one of :data:`FLAGS`) is set.
+
+        Parameters
+        ----------
+        flag : str
+            One of :data:`FLAGS`, e.g. ``"translational_output"``.
+        """
         if flag not in FLAGS:
             raise ModelError(f"unknown flag '{flag}'; expected one of {FLAGS}")
         return [s.number for s in self.stations if getattr(s, flag)]
@@ -247,7 +263,13 @@ def parse_station_table(text: str, source: str = "<string>") -> StationTable:
 
 
 def read_station_table(path: str | os.PathLike) -> StationTable:
-    """Read a station table file (see :func:`parse_station_table`)."""
+    """Read a station table file (see :func:`parse_station_table`).
+
+    Parameters
+    ----------
+    path : str or path-like
+        The file (UTF-8 text).
+    """
     try:
         path = os.fspath(path)
     except TypeError:

@@ -115,6 +115,15 @@ def _system(system: str) -> dict:
 def to_si(value: float, quantity: str, system: str = "SI") -> float:
     """Convert ``value`` of ``quantity`` from ``system`` to SI.
 
+    Parameters
+    ----------
+    value : float
+        The number in the units of ``system``.
+    quantity : str
+        A key of :data:`QUANTITIES` (``"length"``, ``"mass"``, ...).
+    system : str, optional
+        ``"SI"`` or ``"inch-pound"``.
+
     Examples
     --------
     >>> round(to_si(1.0, "length", "inch-pound"), 4)
@@ -127,7 +136,17 @@ def to_si(value: float, quantity: str, system: str = "SI") -> float:
 
 
 def from_si(value: float, quantity: str, system: str = "SI") -> float:
-    """Inverse of :func:`to_si`."""
+    """Inverse of :func:`to_si`.
+
+    Parameters
+    ----------
+    value : float
+        The number in SI.
+    quantity : str
+        A key of :data:`QUANTITIES` (``"length"``, ``"mass"``, ...).
+    system : str, optional
+        ``"SI"`` or ``"inch-pound"``.
+    """
     sysd = _system(system)
     if quantity not in sysd:
         raise ModelError(f"unknown quantity '{quantity}'; expected one of {sorted(sysd)}")
@@ -145,10 +164,30 @@ def _scalar_or_array(x):
 
 
 def rpm_to_rad_s(rpm):
-    """Revolutions per minute to rad/s (``2 pi / 60``); scalars or arrays."""
+    """Revolutions per minute to rad/s (``2 pi / 60``); scalars or arrays.
+
+    Parameters
+    ----------
+    rpm : float or array_like
+        Speed in revolutions per minute.
+
+    Examples
+    --------
+    >>> from mutext.rotor import rpm_to_rad_s, rad_s_to_rpm
+    >>> round(rpm_to_rad_s(600.0), 4)
+    62.8319
+    >>> rad_s_to_rpm([62.83185307179586, 0.0])
+    array([600.,   0.])
+    """
     return _scalar_or_array(np.asarray(rpm, dtype=float) * (2.0 * math.pi / 60.0))
 
 
 def rad_s_to_rpm(omega):
-    """rad/s to revolutions per minute; scalars or arrays."""
+    """rad/s to revolutions per minute; scalars or arrays.
+
+    Parameters
+    ----------
+    omega : float or array_like
+        Speed in rad/s.
+    """
     return _scalar_or_array(np.asarray(omega, dtype=float) * (60.0 / (2.0 * math.pi)))
