@@ -60,14 +60,39 @@ DEGENERATE_TOL = 1e-6
 
 
 def log_decrement(eigenvalues) -> np.ndarray:
-    r"""Logarithmic decrement :math:`\delta = -2\pi\,\mathrm{Re}\,\lambda/\mathrm{Im}\,\lambda` of each root."""
+    r"""Logarithmic decrement :math:`\delta = -2\pi\,\mathrm{Re}\,\lambda/\mathrm{Im}\,\lambda` of each root.
+
+    Parameters
+    ----------
+    eigenvalues : array_like of complex
+        Roots :math:`\lambda` [1/s] (upper half plane: positive imaginary part).
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from mutext.rotor.campbell_diagram import log_decrement
+    >>> zeta, wn = 0.01, 100.0
+    >>> lam = -zeta * wn + 1j * wn * np.sqrt(1 - zeta ** 2)
+    >>> round(float(log_decrement([lam])[0]), 4)          # 2 pi zeta / sqrt(1 - zeta^2)
+    0.0628
+    """
     lam = np.asarray(eigenvalues, complex)
     return -2.0 * np.pi * lam.real / lam.imag
 
 
 def whirl_labels(whirl, frequencies_hz, *, threshold: float = 0.5) -> list[str]:
     """``forward``/``backward``/``mixed`` per mode from the whirl index; ``degenerate`` for the
-    members of a pair whose frequencies agree to :data:`DEGENERATE_TOL` (relative)."""
+    members of a pair whose frequencies agree to :data:`DEGENERATE_TOL` (relative).
+
+    Parameters
+    ----------
+    whirl : (n,) array_like
+        Whirl index of each mode.
+    frequencies_hz : (n,) array_like
+        Frequency [Hz] of each mode (NaN for a missing mode).
+    threshold : float, optional
+        Whirl index above which a mode is forward (below minus it, backward).
+    """
     f = np.asarray(frequencies_hz, float)
     out = []
     for r, w in enumerate(np.asarray(whirl, float)):
@@ -81,7 +106,21 @@ def whirl_labels(whirl, frequencies_hz, *, threshold: float = 0.5) -> list[str]:
 
 @dataclass(frozen=True)
 class Crossing:
-    """Where the excitation line of ``order`` crosses mode curve ``mode`` (0-based)."""
+    """Where the excitation line of ``order`` crosses mode curve ``mode`` (0-based).
+
+    Attributes
+    ----------
+    order : int
+        Excitation order (the line f = order x speed).
+    mode : int
+        0-based index of the mode curve.
+    speed : float
+        Speed of the crossing [rad/s].
+    frequency_hz : float
+        Frequency of the crossing [Hz].
+    whirl : str
+        Whirl of the mode there (``forward``, ``backward``, ``mixed``, ``degenerate``).
+    """
     order: int
     mode: int
     speed: float            # rad/s
@@ -115,6 +154,8 @@ class CampbellDiagram:
         Excitation orders whose crossings were sought.
     crossings : list of Crossing
         Sorted by order, then speed.
+    name : str
+        Name of the model.
     """
     speeds: np.ndarray
     frequencies_hz: np.ndarray
@@ -131,7 +172,15 @@ class CampbellDiagram:
         return self.speeds * 30.0 / np.pi
 
     def critical_speeds(self, order: int = 1, whirl: str | None = "forward") -> list[Crossing]:
-        """Crossings of the ``order`` line, with modes of ``whirl`` direction (None: all)."""
+        """Crossings of the ``order`` line, with modes of ``whirl`` direction (None: all).
+
+        Parameters
+        ----------
+        order : int, optional
+            Excitation order (1 for the 1x line).
+        whirl : {"forward", "backward", "mixed"} or None, optional
+            Keep the crossings with modes of this whirl (None: all).
+        """
         return [c for c in self.crossings if c.order == order and (whirl is None or c.whirl == whirl)]
 
     def to_dict(self) -> dict:
@@ -143,7 +192,15 @@ class CampbellDiagram:
 
 
 def speed_grid(speeds, name="model") -> np.ndarray:
-    """``speeds`` [rad/s] checked: a non-empty 1-D array of finite, non-negative, increasing speeds."""
+    """``speeds`` [rad/s] checked: a non-empty 1-D array of finite, non-negative, increasing speeds.
+
+    Parameters
+    ----------
+    speeds : array_like
+        Speeds [rad/s].
+    name : str, optional
+        Name of the model in the error message.
+    """
     try:
         s = np.atleast_1d(np.asarray(speeds, dtype=float))
     except (TypeError, ValueError):

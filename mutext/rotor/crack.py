@@ -388,6 +388,8 @@ def crack_compliance(depth_ratio, E, D, nu=0.3, *, n_quad: int = 16, component=5
         Poisson's ratio [-] (plane-strain factor :math:`1-\nu^2`).
     component : {55, 44, "c55", "c44"}
         Which compliance (default 55, the moment parallel to the crack edge).
+    n_quad : int, optional
+        Gauss-Legendre points of the strip integration along the crack edge.
 
     Returns
     -------
@@ -410,6 +412,19 @@ def crack_rotational_stiffness(depth_ratio, E, D, nu=0.3, *, n_quad: int = 16):
     Infinite at zero depth (no crack).  For an optimisation over the depth
     prefer :func:`cracked_element_stiffness`, which uses the compliance and
     stays finite; see :func:`crack_compliance` for the parameters.
+
+    Parameters
+    ----------
+    depth_ratio : float or casadi scalar
+        Crack depth over shaft diameter, :math:`a/D \in [0, 0.5]`.
+    E : float or casadi scalar
+        Young's modulus [Pa].
+    D : float or casadi scalar
+        Shaft diameter at the crack [m].
+    nu : float or casadi scalar, optional
+        Poisson's ratio.
+    n_quad : int, optional
+        Gauss-Legendre points of the strip integration along the crack edge.
     """
     c = crack_compliance(depth_ratio, E, D, nu, n_quad=n_quad)
     if _symbolic(c):
@@ -437,6 +452,19 @@ def open_crack_element(depth_ratio, E, D, nu=0.3, *, n_quad: int = 16):
     :math:`\theta = -dw/dz`.  Not usable at zero depth (infinite stiffness):
     for a depth that may reach zero, or for a two-plane rotor, use
     :func:`cracked_element_stiffness` instead.
+
+    Parameters
+    ----------
+    depth_ratio : float or casadi scalar
+        Crack depth over shaft diameter, :math:`a/D \in [0, 0.5]`.
+    E : float or casadi scalar
+        Young's modulus [Pa].
+    D : float or casadi scalar
+        Shaft diameter at the crack [m].
+    nu : float or casadi scalar, optional
+        Poisson's ratio.
+    n_quad : int, optional
+        Gauss-Legendre points of the strip integration along the crack edge.
 
     Returns
     -------
@@ -574,6 +602,25 @@ def cracked_element_stiffness_two_plane(L, E, I, compliance, angle, *, position=
     Parameters as in :func:`cracked_element_stiffness`; ``angle`` in rad,
     ``compliance_eta`` in rad/(N m).
 
+    Parameters
+    ----------
+    L : float or casadi scalar
+        Element length [m].
+    E : float or casadi scalar
+        Young's modulus [Pa].
+    I : float or casadi scalar
+        Second moment of area of the healthy section [m^4].
+    compliance : float or casadi scalar
+        Compliance :math:`c_{55}` [rad/(N m)] for bending in the plane of the crack normal.
+    angle : float or casadi scalar
+        Angle [rad] of the crack normal from the x axis.
+    position : float, optional
+        Crack location as a fraction of the element length, in [0, 1].
+    phi : float or casadi scalar, optional
+        Timoshenko shear parameter (0 for Euler-Bernoulli).
+    compliance_eta : float or casadi scalar, optional
+        Compliance :math:`c_{44}` [rad/(N m)] for bending in the plane of the crack edge.
+
     Returns
     -------
     (8, 8) numpy.ndarray or casadi matrix
@@ -652,6 +699,13 @@ def open_fraction(psi, model: str = "mayes"):
     * ``"closed"``: :math:`f = 0` (healthy).
 
     Works on floats, numpy arrays and CasADi expressions.
+
+    Parameters
+    ----------
+    psi : float, ndarray or casadi expression
+        Angle [rad] between the crack normal and the direction of the bending deflection.
+    model : {"mayes", "gasch", "gaping", "closed"}, optional
+        The breathing law (:func:`open_fraction`).
     """
     if model not in _MODELS:
         raise ModelError(f"crack model must be one of {_MODELS}, got {model!r}")
@@ -681,6 +735,20 @@ def rotating_frame_stiffness(k0, dk_xi, dk_eta, psi, model: str = "mayes"):
     :math:`c_{44}`) is often taken as zero ([Ga93]_), which holds for shallow
     cracks only: for the rig's crack (:math:`a/D = 0.4`) it is about 0.44
     :math:`\Delta k_\xi` (see :class:`Crack`).
+
+    Parameters
+    ----------
+    k0 : float
+        Stiffness of the healthy shaft [N/m].
+    dk_xi : float
+        Stiffness loss of the fully open crack for bending across the crack edge [N/m].
+    dk_eta : float
+        Stiffness loss for bending in the plane of the crack edge [N/m].
+
+    psi : float or ndarray
+        Angle [rad] between the crack normal and the bending direction.
+    model : {"mayes", "gasch", "gaping", "closed"}, optional
+        The breathing law (:func:`open_fraction`).
     """
     f = open_fraction(psi, model)
     return k0 - f * dk_xi, k0 - f * dk_eta
@@ -706,6 +774,22 @@ def fixed_frame_stiffness(k0, dk_xi, dk_eta, theta, psi, model: str = "mayes"):
     :math:`f` they produce the 1X, 2X and 3X components of a breathing
     crack.  Returns a numpy (2, 2) array (or an array of shape (2, 2, n)
     for arrays of angles).
+
+    Parameters
+    ----------
+    k0 : float
+        Stiffness of the healthy shaft [N/m].
+    dk_xi : float
+        Stiffness loss of the fully open crack for bending across the crack edge [N/m].
+    dk_eta : float
+        Stiffness loss for bending in the plane of the crack edge [N/m].
+
+    theta : float or ndarray
+        Angle [rad] of the crack normal from x (the shaft's rotation angle).
+    psi : float or ndarray
+        Angle [rad] between the crack normal and the bending direction.
+    model : {"mayes", "gasch", "gaping", "closed"}, optional
+        The breathing law (:func:`open_fraction`).
     """
     f = open_fraction(psi, model)
     s = 0.5 * (dk_xi + dk_eta)
@@ -726,7 +810,19 @@ BREATHING_ALIASES = {"open": "gaping", "notch": "gaping"}
 
 
 def breathing_law(name) -> str:
-    """The documented name of breathing law ``name`` (an alias resolved), or a :class:`ModelError`."""
+    """The documented name of breathing law ``name`` (an alias resolved), or a :class:`ModelError`.
+
+    Parameters
+    ----------
+    name : str
+        A law of :data:`BREATHING_LAWS` or an alias of :data:`BREATHING_ALIASES`.
+
+    Examples
+    --------
+    >>> from mutext.rotor.crack import breathing_law
+    >>> breathing_law("mayes"), breathing_law("notch")
+    ('mayes', 'gaping')
+    """
     if isinstance(name, str):
         name = BREATHING_ALIASES.get(name, name)
         if name in BREATHING_LAWS:
@@ -752,6 +848,13 @@ def breathing_weights(theta, law: str):
     crack is open when its normal points down, :math:`\theta = -\pi/2`).
     Returns the three weights :math:`f\cos^2\theta`, :math:`f\sin^2\theta`,
     :math:`f\sin\theta\cos\theta` (arrays shaped like ``theta``).
+
+    Parameters
+    ----------
+    theta : float or ndarray
+        Shaft angle [rad] (the angle of the crack normal from x).
+    law : str
+        A breathing law (:func:`breathing_law`).
     """
     law = breathing_law(law)
     th = np.asarray(theta, dtype=float)
@@ -770,6 +873,15 @@ def breathing_fourier(law: str, n_terms: int = 16, *, samples: int = 4096) -> np
     and 2), so their coefficients are exact; the Gasch law switches at
     :math:`\theta = 0, \pi` and its coefficients decay like :math:`1/m`
     (trapezoidal rule with the jumps on samples: error :math:`O(\text{samples}^{-2})`).
+
+    Parameters
+    ----------
+    law : str
+        A breathing law (:func:`breathing_law`).
+    n_terms : int, optional
+        Highest order m kept.
+    samples : int, optional
+        Samples over the revolution of the quadrature.
     """
     law = breathing_law(law)
     if isinstance(n_terms, bool) or not isinstance(n_terms, (int, np.integer)) or n_terms < 0:
@@ -833,6 +945,19 @@ def face_displacement(moment, compliance, depth):
 
 class BreathingChoice:
     """Which crack law a slot of given width follows, and why (:func:`choose_breathing`).
+
+    Parameters
+    ----------
+    law : str
+        ``"gaping"`` or the closing law.
+    slot_width : float
+        Gap between the faces at rest [m].
+    face_displacement : float
+        Movement of the faces at the mouth under the shaft's weight [m].
+    moment : float
+        Static bending moment at the crack [N m].
+    reason : str
+        The comparison that decided, in words.
 
     Attributes
     ----------
@@ -904,6 +1029,8 @@ def choose_breathing(rotor, station: int, depth_ratio: float, slot_width: float,
     closing_law : {"mayes", "gasch"}
     gravity : float
         [m/s^2].
+    name : str, optional
+        Name of the crack in the messages.
 
     Returns
     -------
@@ -1077,6 +1204,13 @@ def _make_crack_class():
             self.host = None
 
         def bind(self, structure):
+            """Find the host shaft element in ``structure`` (called by the assembly).
+
+            Parameters
+            ----------
+            structure : Rotor
+                The rotor; the host is its shaft element starting at the crack's station (a solid one).
+            """
             if not isinstance(structure, Rotor):
                 raise ModelError(f"{self.name}: a crack needs a Rotor")
             self.host = structure.shaft_element(self.nodes[0])
@@ -1086,7 +1220,15 @@ def _make_crack_class():
                                  f"{self.host.nominal('di'):g} m")
 
         def compliance(self, p, component=55):
-            """Crack compliance ``c55`` (default) or ``c44`` [rad/(N m)] as an expression of ``p``."""
+            """Crack compliance ``c55`` (default) or ``c44`` [rad/(N m)] as an expression of ``p``.
+
+            Parameters
+            ----------
+            p : mapping of str to casadi.SX
+                Parameter name -> symbol (the depth ratio and the host's material and diameter).
+            component : {55, 44}, optional
+                Which compliance.
+            """
             h = self.host
             E, D = h.sym(p, "E"), h.sym(p, "do")
             nu = h.sym(p, "nu") if h.has("nu") else E / (2.0 * h.sym(p, "G")) - 1.0
@@ -1096,7 +1238,13 @@ def _make_crack_class():
         def crack_frame_deltas(self, p):
             r"""Plane changes :math:`(\Delta_\xi, \Delta_\eta)` (4x4) of the host element for
             bending in the plane of the crack normal (:math:`c_{55}`) and of the crack edge
-            (:math:`c_{44}`); :math:`\Delta_\eta` is ``None`` with ``perpendicular=False``."""
+            (:math:`c_{44}`); :math:`\Delta_\eta` is ``None`` with ``perpendicular=False``.
+
+            Parameters
+            ----------
+            p : mapping of str to casadi.SX
+                Parameter name -> symbol.
+            """
             d_xi = self.plane_delta(p, self.compliance(p, 55))
             d_eta = self.plane_delta(p, self.compliance(p, 44)) if self.perpendicular else None
             return d_xi, d_eta
@@ -1117,7 +1265,15 @@ def _make_crack_class():
             :math:`\cos^2\beta A_{xx} + \sin^2\beta A_{yy} + \sin\beta\cos\beta A_{xy}`:
             :math:`A_{xx} = \Delta_\xi` in x-z and :math:`\Delta_\eta` in y-z,
             :math:`A_{yy}` the other way round, :math:`A_{xy}` the coupling of
-            :math:`\Delta_\xi - \Delta_\eta`."""
+            :math:`\Delta_\xi - \Delta_\eta`.
+
+            Parameters
+            ----------
+            p : mapping of str to casadi.SX
+                Parameter name -> symbol.
+            layout : Layout
+                The DOF numbering of the rotor (two planes for a turning crack).
+            """
             if layout.kind != "rotor":
                 raise ModelError(f"{self.name}: a turning crack needs two bending planes (planes = 2)")
             d_xi, d_eta = self.crack_frame_deltas(p)
@@ -1129,6 +1285,15 @@ def _make_crack_class():
                     Axy - ca.mtimes([T_XZ.T, d_eta, T_YZ]) - ca.mtimes([T_YZ.T, d_eta, T_XZ]))
 
         def stiffness_matrix(self, p, layout):
+            """Stiffness change of the crack (CasADi ``SX``): the open crack at its orientation, the mean of the two orientations, or for a breathing crack the time average of its law.
+
+            Parameters
+            ----------
+            p : mapping of str to casadi.SX
+                Parameter name -> symbol.
+            layout : Layout
+                The DOF numbering of the rotor (two planes for a turning crack).
+            """
             if self.breathing is not None:
                 c0 = breathing_fourier(self.breathing, 0)[0].real
                 Axx, Ayy, Axy = self.directional_deltas(p, layout)

@@ -48,7 +48,21 @@ __all__ = ["Ellipse", "ellipse", "Orbit", "orbit"]
 
 @dataclass(frozen=True)
 class Ellipse:
-    """The orbit of one harmonic (see the module docstring); lengths in m, angle in rad."""
+    """The orbit of one harmonic (see the module docstring); lengths in m, angle in rad.
+
+    Attributes
+    ----------
+    forward : complex
+        Forward-whirling component :math:`R_+` [m].
+    backward : complex
+        Backward-whirling component :math:`R_-` [m].
+    semi_major, semi_minor : float
+        Semi-axes [m].
+    angle : float
+        Angle of the major axis from x [rad].
+    direction : str
+        ``"forward"``, ``"backward"`` or ``"straight"`` (a line).
+    """
     forward: complex            # R+
     backward: complex           # R-
     semi_major: float
@@ -62,7 +76,20 @@ class Ellipse:
 
 
 def ellipse(X, Y) -> Ellipse:
-    r"""Forward/backward decomposition of one harmonic with complex amplitudes ``X``, ``Y`` [m]."""
+    r"""Forward/backward decomposition of one harmonic with complex amplitudes ``X``, ``Y`` [m].
+
+    Parameters
+    ----------
+    X, Y : complex
+        Amplitudes [m] of :math:`x = \mathrm{Re}\,X e^{j\Omega t}` and likewise y.
+
+    Examples
+    --------
+    >>> from mutext.rotor.orbits import ellipse
+    >>> e = ellipse(2e-6, 1e-6j)                        # x = 2 cos, y = -1 sin: an ellipse whirling backward
+    >>> e.direction, round(e.semi_major * 1e6, 6), round(e.semi_minor * 1e6, 6)
+    ('backward', 2.0, 1.0)
+    """
     X, Y = complex(X), complex(Y)
     rp = 0.5 * (X + 1j * Y)
     rm = 0.5 * np.conj(X - 1j * Y)
@@ -103,7 +130,13 @@ class Orbit:
     label: str = ""
 
     def ellipse(self, order: int = 1) -> Ellipse:
-        """The forward/backward decomposition of one order."""
+        """The forward/backward decomposition of one order.
+
+        Parameters
+        ----------
+        order : int, optional
+            Harmonic order (a key of ``harmonics``).
+        """
         if order not in self.harmonics:
             raise ModelError(f"order {order} is not among the orbit's harmonics {sorted(self.harmonics)}")
         return ellipse(*self.harmonics[order])
@@ -146,6 +179,8 @@ def orbit(harmonics, speed: float, *, points: int = 361, label: str = "") -> Orb
         Spin speed [rad/s] (> 0).
     points : int
         Samples over the revolution (the last closes the curve).
+    label : str, optional
+        Name of the orbit (e.g. the probe), for plots.
 
     Examples
     --------

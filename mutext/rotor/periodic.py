@@ -140,6 +140,16 @@ class PeriodicRotor:
     reduction_error : float or None
         Largest relative error of the reduced time-averaged FRF on the band
         it was checked on (see :meth:`reduce`).
+    inputs, outputs : list of str
+        Names of the input and output ports (the columns of ``B``, the rows of ``Cy``).
+    ports : dict
+        Port name -> ``(station, direction, quantity)``.
+    name : str
+        Name of the model.
+    cutoff_hz : float or None
+        Cutoff of the reduction [Hz], or None.
+    reduction_band_hz : tuple or None
+        Band [Hz] on which ``reduction_error`` was measured.
     """
     M: np.ndarray
     D: np.ndarray
@@ -168,7 +178,13 @@ class PeriodicRotor:
 
     def stiffness_harmonics(self, max_order: int) -> dict:
         r""":math:`K_m` for :math:`|m| \le` ``max_order`` (complex ``n x n``), with
-        :math:`K(t) = \sum_m K_m e^{jm\Omega t}`; ``K_0`` includes :math:`K_h`."""
+        :math:`K(t) = \sum_m K_m e^{jm\Omega t}`; ``K_0`` includes :math:`K_h`.
+
+        Parameters
+        ----------
+        max_order : int
+            Highest order :math:`|m|` returned.
+        """
         Km = {m: np.zeros((self.n, self.n), complex) for m in range(-max_order, max_order + 1)}
         Km[0] = Km[0] + self.K_healthy
         for c in self.cracks:
@@ -181,7 +197,13 @@ class PeriodicRotor:
 
     def stiffness_at(self, theta) -> np.ndarray:
         r"""Stiffness at shaft angles ``theta`` [rad] (the angle of the rotation, :math:`\Omega t`),
-        from the breathing laws themselves; shape ``(len(theta), n, n)``."""
+        from the breathing laws themselves; shape ``(len(theta), n, n)``.
+
+        Parameters
+        ----------
+        theta : float or array_like
+            Shaft angles [rad].
+        """
         th = np.atleast_1d(np.asarray(theta, float))
         K = np.broadcast_to(self.K_healthy, (th.size, self.n, self.n)).copy()
         for c in self.cracks:
@@ -194,7 +216,13 @@ class PeriodicRotor:
         return not self.cracks or self.speed == 0.0
 
     def ritz_basis(self, cutoff_hz: float) -> np.ndarray:
-        """The mass-orthonormal Ritz basis of :meth:`reduce` (``ndof x r``), without the error check."""
+        """The mass-orthonormal Ritz basis of :meth:`reduce` (``ndof x r``), without the error check.
+
+        Parameters
+        ----------
+        cutoff_hz : float
+            Modes of the time-averaged stiffness below this frequency [Hz] are kept.
+        """
         if self.basis is not None:
             raise ModelError(f"{self.name}: the model is already reduced")
         if not (isinstance(cutoff_hz, (int, float)) and np.isfinite(cutoff_hz) and cutoff_hz > 0):
@@ -230,6 +258,13 @@ class PeriodicRotor:
         transfer functions :math:`H_0` and :math:`H_{\pm 1}` with N = 2 on
         every 10th of those frequencies): the largest deviation over the
         largest response, over every channel.
+
+        Parameters
+        ----------
+        cutoff_hz : float
+            Modes of the time-averaged stiffness below this frequency [Hz] are kept.
+        band_hz : (float, float), optional
+            Band [Hz] on which the reduction error is measured.
         """
         red = self.project(self.ritz_basis(cutoff_hz))
         red.cutoff_hz = float(cutoff_hz)
@@ -248,7 +283,13 @@ class PeriodicRotor:
 
 def _project(self, P) -> "PeriodicRotor":
     """The model on the mass-orthonormal basis ``P`` (``ndof x r``, e.g. the ``basis`` of a
-    reduction of a neighbouring model: the same rotor with another crack depth)."""
+    reduction of a neighbouring model: the same rotor with another crack depth).
+
+    Parameters
+    ----------
+    P : (ndof, r) array_like
+        Mass-orthonormal basis.
+    """
     if self.basis is not None:
         raise ModelError(f"{self.name}: the model is already reduced")
     P = np.asarray(P, float)
@@ -352,6 +393,23 @@ class HarmonicResponse:
 
     ``H[k + N]`` has shape ``(noutputs, ninputs, nfreq)``: the response at
     :math:`\omega + k\Omega` to a unit input :math:`e^{j\omega t}`.
+
+    Attributes
+    ----------
+    freqs_hz : (nfreq,) ndarray
+        Excitation frequencies [Hz].
+    H : (2N+1, noutputs, ninputs, nfreq) complex ndarray
+        The harmonic transfer functions, output unit per input unit.
+    harmonics : int
+        The truncation N.
+    speed : float
+        Spin speed [rad/s].
+    inputs, outputs : list of str
+        Port names.
+    ports : dict
+        Port name -> ``(station, direction, quantity)``.
+    seconds : float
+        Wall time of the computation.
     """
     freqs_hz: np.ndarray
     H: np.ndarray
@@ -380,6 +438,18 @@ def harmonic_response(model, freqs_hz, *, harmonics: int = 6, inputs=None, outpu
     ``inputs``/``outputs`` select the ports).  Cost: one dense complex solve
     of size :math:`(2N+1)n` per frequency, so reduce the full finite-element
     model first for sweeps (:meth:`PeriodicRotor.reduce`).
+
+    Parameters
+    ----------
+    model : PeriodicRotor or Rotor
+        The time-periodic model (full or reduced), or a rotor with a turning crack
+        (then built with :func:`periodic_rotor`).
+    freqs_hz : array_like
+        Excitation frequencies [Hz] (positive).
+    harmonics : int, optional
+        Truncation N of the harmonic balance (orders -N..N).
+    inputs, outputs : sequence of str, optional
+        Ports of a Rotor ``model`` (default: all); not with a :class:`PeriodicRotor`.
     """
     t0 = time.perf_counter()
     pr = _as_periodic(model, inputs, outputs)
@@ -450,6 +520,25 @@ def analyzer_frf(model, freqs_hz, *, harmonics: int = 6, revolutions: int = ANAL
     \varphi)` starting with the rotor at its angle zero.  Transients are not
     included (see :func:`stepped_sine` for those).
 
+    Parameters
+    ----------
+    model : PeriodicRotor or Rotor
+        The time-periodic model (full or reduced), or a rotor with a turning crack
+        (then built with :func:`periodic_rotor`).
+    freqs_hz : array_like
+        Excitation frequencies [Hz] (positive).
+    harmonics : int, optional
+        Truncation N of the harmonic balance (orders -N..N).
+    revolutions : int, optional
+        Turns of the correlation window.
+    settle_s : float, optional
+        Settling time before the window [s].
+    excitation_phase : float, optional
+        Phase :math:`\varphi` [rad] of the excitation :math:`a\cos(\omega t + \varphi)`
+        with the rotor at its angle zero at t = 0.
+    inputs, outputs : sequence of str, optional
+        Ports of a Rotor ``model`` (default: all); not with a :class:`PeriodicRotor`.
+
     Examples
     --------
     >>> from mutext.rotor import loads_model, data_path
@@ -490,6 +579,28 @@ def analyzer_combination(model, freqs_hz, orders=(-2, -1, 1, 2), *, harmonics: i
     :math:`2f` is a multiple of the speed, order ``k`` draws on
     :math:`H_{-k-2f/F}`).
 
+    Parameters
+    ----------
+    model : PeriodicRotor or Rotor
+        The time-periodic model (full or reduced), or a rotor with a turning crack
+        (then built with :func:`periodic_rotor`).
+    freqs_hz : array_like
+        Excitation frequencies [Hz] (positive).
+
+    orders : sequence of int, optional
+        Orders k of the combination frequencies :math:`\omega + k\Omega`.
+    harmonics : int, optional
+        Truncation N of the harmonic balance (orders -N..N).
+    revolutions : int, optional
+        Turns of the correlation window.
+    settle_s : float, optional
+        Settling time before the window [s].
+    excitation_phase : float, optional
+        Phase :math:`\varphi` [rad] of the excitation :math:`a\cos(\omega t + \varphi)`
+        with the rotor at its angle zero at t = 0.
+    inputs, outputs : sequence of str, optional
+        Ports of a Rotor ``model`` (default: all); not with a :class:`PeriodicRotor`.
+
     Returns
     -------
     dict
@@ -523,7 +634,21 @@ def harmonic_convergence(model, freqs_hz, *, harmonics: Sequence[int] = (0, 1, 2
                          inputs=None, outputs=None) -> list[dict]:
     """How :math:`H_0` settles as the truncation grows: for each N, the largest change
     relative to the largest N (over the frequencies and channels, relative to the
-    largest response) and the time taken."""
+    largest response) and the time taken.
+
+    Parameters
+    ----------
+    model : PeriodicRotor or Rotor
+        The time-periodic model (full or reduced), or a rotor with a turning crack
+        (then built with :func:`periodic_rotor`).
+    freqs_hz : array_like
+        Excitation frequencies [Hz] (positive).
+
+    harmonics : sequence of int, optional
+        Truncations N to compare (the largest is the reference).
+    inputs, outputs : sequence of str, optional
+        Ports of a Rotor ``model`` (default: all); not with a :class:`PeriodicRotor`.
+    """
     pr = _as_periodic(model, inputs, outputs)
     Ns = sorted({_harmonics(n) for n in harmonics})
     res = [harmonic_response(pr, freqs_hz, harmonics=n) for n in Ns]
@@ -596,6 +721,35 @@ def stepped_sine(model, freqs_hz, *, in_port: str | None = None, out_port: str |
     not rely on their Fourier series.  ``orders`` adds the correlations at
     the combination frequencies :math:`\omega + k\Omega` (the independent
     check of :func:`analyzer_combination`).
+
+    Parameters
+    ----------
+    model : PeriodicRotor or Rotor
+        The time-periodic model (full or reduced), or a rotor with a turning crack
+        (then built with :func:`periodic_rotor`).
+    freqs_hz : array_like
+        Excitation frequencies [Hz] (positive).
+
+    in_port, out_port : str, optional
+        The excited input and the measured output (default: the first of each).
+    amplitude : float, optional
+        Excitation amplitude (input unit, e.g. A).
+    revolutions : int, optional
+        Turns of the correlation window.
+    settle_s : float, optional
+        Settling time before the window [s].
+    excitation_phase : float, optional
+        Phase :math:`\varphi` [rad] of the excitation :math:`a\cos(\omega t + \varphi)`
+        with the rotor at its angle zero at t = 0.
+
+    steps_per_rev : int, optional
+        Runge-Kutta steps per revolution (default: from the stability limit).
+    cutoff_hz : float, optional
+        Cutoff [Hz] of the reduction when ``model`` is not reduced.
+    progress : callable, optional
+        Called with the fraction of the work done (0..1).
+    orders : sequence of int, optional
+        Orders k of the combination frequencies also correlated.
 
     Returns
     -------

@@ -52,7 +52,17 @@ GRAVITY = 9.80665
 
 
 def weight_force(model, M=None, gravity: float = GRAVITY) -> np.ndarray:
-    """Consistent weight load [N, N m]: :math:`-g\\,M e_y`, with :math:`e_y` one on every y translation."""
+    """Consistent weight load [N, N m]: :math:`-g\\,M e_y`, with :math:`e_y` one on every y translation.
+
+    Parameters
+    ----------
+    model : Rotor
+        The rotor (two planes).
+    M : (ndof, ndof) ndarray, optional
+        Mass matrix (default: ``model.matrices().M``).
+    gravity : float, optional
+        Acceleration of gravity [m/s^2].
+    """
     if M is None:
         M = model.matrices().M
     e = np.zeros(model.ndof)
@@ -83,6 +93,15 @@ def periodic_steady_state(pr, forces: dict, harmonics: int) -> np.ndarray:
     ``forces`` maps order k >= 0 to the complex force of :math:`\mathrm{Re}\,F_k e^{jk\Omega t}` (order 0:
     real, constant).  Returns :math:`Q` of shape ``(2N+1, n)``, row ``k + N`` the two-sided coefficient of
     :math:`e^{jk\Omega t}`.
+
+    Parameters
+    ----------
+    pr : PeriodicRotor
+        The time-periodic model.
+    forces : dict
+        Order k >= 0 -> complex force vector (``n``) [N].
+    harmonics : int
+        Truncation N of the harmonic balance.
     """
     N = int(harmonics)
     n = pr.n
@@ -126,6 +145,8 @@ class PeriodicResponse:
     X, Y : complex ndarray (N+1, p)
         Row k: amplitude of order k (one-sided, ``Re X_k e^{jk Omega t}``; row 0 the static offset) [m].
     harmonics : int
+    name : str
+        Name of the model.
     """
     speed: float
     probes: list
@@ -135,12 +156,32 @@ class PeriodicResponse:
     name: str = ""
 
     def amplitude(self, order: int, probe: int = 0) -> float:
-        """Amplitude [m] of ``order`` along the probe's direction."""
+        """Amplitude [m] of ``order`` along the probe's direction.
+
+        Parameters
+        ----------
+        order : int
+            Harmonic order (0..harmonics).
+        probe : int, optional
+            Index into ``probes``.
+        """
         a = self.probes[probe][1]
         return float(abs(self.X[order, probe] * np.cos(a) + self.Y[order, probe] * np.sin(a)))
 
     def orbit(self, probe: int = 0, *, orders=None, points: int = 721, static: bool = False) -> Orbit:
-        """The orbit at ``probe`` (index) from ``orders`` (default all k >= 1; ``static`` adds the sag)."""
+        """The orbit at ``probe`` (index) from ``orders`` (default all k >= 1; ``static`` adds the sag).
+
+        Parameters
+        ----------
+        probe : int, optional
+            Index into ``probes``.
+        orders : sequence of int, optional
+            Harmonic orders to include (default: all k >= 1).
+        points : int, optional
+            Samples over the revolution.
+        static : bool, optional
+            Include the static offset (order 0, the sag under weight).
+        """
         ks = range(0 if static else 1, self.harmonics + 1) if orders is None else orders
         h = {int(k): (self.X[k, probe], self.Y[k, probe]) for k in ks}
         return orbit(h, self.speed, points=points,

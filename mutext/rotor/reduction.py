@@ -157,6 +157,8 @@ class Reduction:
         Modal truncation: whether the residual flexibility was added.
     seconds : float
         Time for the reduction (without the error evaluation).
+    info : dict
+        Further measurements of the error (e.g. ``max_abs_error``, ``hinf_source``).
     """
     system: ct.StateSpace
     full: ct.StateSpace
@@ -491,6 +493,13 @@ def hankel_singular_values(sys, *, scale: bool = True) -> np.ndarray:
     of the Gramians), which is more accurate than the eigenvalues of
     :math:`PQ`.  ``scale`` applies a diagonal state scaling first (does not
     change the values, improves the Lyapunov solutions).
+
+    Parameters
+    ----------
+    sys : StateSpace or as accepted by :func:`mutext.lti.as_ss`
+        A stable model.
+    scale : bool, optional
+        Balance the states by a diagonal scaling first.
     """
     sys = as_ss(sys, "system")
     if sys.nstates == 0:

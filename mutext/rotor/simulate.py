@@ -63,13 +63,24 @@ class JeffcottResult:
         :math:`x(t) \approx \sum_n \mathrm{Re}(X_n e^{j n\Omega t})`; computed
         exactly as a DFT bin because the record spans whole revolutions
         sampled uniformly (order 0 is the mean).
+
+        Parameters
+        ----------
+        order : int
+            Multiple of the running speed (0 for the mean).
         """
         ph = np.exp(-1j * order * self.speed * self.t)
         scale = 1.0 if order == 0 else 2.0
         return scale * np.array([np.mean(self.x * ph), np.mean(self.y * ph)])
 
     def amplitude(self, order: int) -> float:
-        r"""Size :math:`\sqrt{|X_n|^2 + |Y_n|^2}` (m) of the ``order`` x component."""
+        r"""Size :math:`\sqrt{|X_n|^2 + |Y_n|^2}` (m) of the ``order`` x component.
+
+        Parameters
+        ----------
+        order : int
+            Multiple of the running speed.
+        """
         return float(np.linalg.norm(self.harmonic(order)))
 
 

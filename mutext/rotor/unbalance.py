@@ -57,7 +57,15 @@ __all__ = ["UnbalanceResponse", "unbalance_response", "run_up", "unbalance_force
 
 
 def parse_probes(model, probes) -> list[tuple[int, float]]:
-    """``probes`` as ``[(station, angle_rad), ...]``: a station alone is a probe along x (angle 0)."""
+    """``probes`` as ``[(station, angle_rad), ...]``: a station alone is a probe along x (angle 0).
+
+    Parameters
+    ----------
+    model : Structure or Rotor
+        The model whose stations the probes refer to.
+    probes : int or sequence
+        A station, a list of stations, or ``(station, angle_rad)`` pairs.
+    """
     if probes is None:
         raise ModelError(f"{model.name}: give the probes (stations, or (station, angle_rad) pairs)")
     if isinstance(probes, (int, np.integer)) or (isinstance(probes, tuple) and len(probes) == 2
@@ -113,7 +121,17 @@ def _unbalances(model, station, unbalance_kg_m, phase):
 
 
 def unbalance_force(model, unbalances, speed: float) -> np.ndarray:
-    r"""Complex force vector :math:`F` (``ndof``) of ``[(station, U [kg m], phase [rad]), ...]`` at ``speed``."""
+    r"""Complex force vector :math:`F` (``ndof``) of ``[(station, U [kg m], phase [rad]), ...]`` at ``speed``.
+
+    Parameters
+    ----------
+    model : Rotor
+        The rotor (two planes).
+    unbalances : sequence of (int, float, float)
+        ``(station, U [kg m], phase [rad])`` per unbalance.
+    speed : float
+        Spin speed [rad/s].
+    """
     F = np.zeros(model.ndof, complex)
     for s, u, p in unbalances:
         a = u * speed ** 2 * np.exp(1j * p)
@@ -134,6 +152,8 @@ class UnbalanceResponse:
     X, Y : complex ndarray (s, p)
         x and y amplitudes [m] at each probe's station.
     unbalances : list of (station, U [kg m], phase [rad])
+    name : str
+        Name of the model.
     """
     speeds: np.ndarray
     probes: list
@@ -168,12 +188,28 @@ class UnbalanceResponse:
         return np.array([[ellipse(x, y).semi_major for x, y in zip(rx, ry)] for rx, ry in zip(self.X, self.Y)])
 
     def peak(self, probe: int = 0) -> tuple[float, float]:
-        """(speed [rad/s], amplitude [m]) of the largest amplitude at ``probe`` (index) on the grid."""
+        """(speed [rad/s], amplitude [m]) of the largest amplitude at ``probe`` (index) on the grid.
+
+        Parameters
+        ----------
+        probe : int, optional
+            Index into ``probes``.
+        """
         i = int(np.argmax(self.amplitude[:, probe]))
         return float(self.speeds[i]), float(self.amplitude[i, probe])
 
     def orbit(self, speed_index: int, probe: int = 0, *, points: int = 361) -> Orbit:
-        """The 1x orbit at ``probe`` (index) and ``speeds[speed_index]``."""
+        """The 1x orbit at ``probe`` (index) and ``speeds[speed_index]``.
+
+        Parameters
+        ----------
+        speed_index : int
+            Index into ``speeds``.
+        probe : int, optional
+            Index into ``probes``.
+        points : int, optional
+            Samples over the revolution.
+        """
         st, _ = self.probes[probe]
         return orbit({1: (self.X[speed_index, probe], self.Y[speed_index, probe])}, self.speeds[speed_index],
                      points=points, label=f"station {st}, {self.speeds_rpm[speed_index]:.0f} rpm")
@@ -245,7 +281,27 @@ def run_up(model, station, unbalance_kg_m, speeds: Sequence[float], probes, *, p
            values=None, coast_down: bool = False) -> UnbalanceResponse:
     """The 1x order tracked over a slow run-up (or coast-down): :func:`unbalance_response` on ``speeds``,
     returned in the order of the run (decreasing for ``coast_down``).  The quasi-steady limit: valid
-    while the speed changes little over the decay time of the modes (module docstring)."""
+    while the speed changes little over the decay time of the modes (module docstring).
+
+    Parameters
+    ----------
+    model : Rotor
+        The rotor.
+    station : int
+        1-based station of the unbalance.
+    unbalance_kg_m : float
+        Unbalance :math:`U = m e` [kg m].
+    speeds : sequence of float
+        Speeds of the run [rad/s], in any order.
+    probes : int or sequence
+        Stations, or ``(station, angle_rad)`` pairs (:func:`parse_probes`).
+    phase : float, optional
+        Angle of the unbalance [rad].
+    values : mapping or array_like, optional
+        Parameter values (see :meth:`~mutext.rotor.assembly.Structure.values`).
+    coast_down : bool, optional
+        Return the result in decreasing speed.
+    """
     try:
         s = np.sort(np.atleast_1d(np.asarray(speeds, dtype=float)))
     except (TypeError, ValueError):
