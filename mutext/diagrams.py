@@ -60,7 +60,19 @@ _TOL = 1e-9
 
 @dataclass(frozen=True)
 class Block:
-    """A rectangular block: ``name`` (for the graph), centre ``(x, y)``, width, height, TeX ``text``."""
+    """A rectangular block: ``name`` (for the graph), centre ``(x, y)``, width, height, TeX ``text``.
+
+    Attributes
+    ----------
+    name : str
+        Name of the block in the signal graph.
+    x, y : float
+        Centre (drawing units).
+    w, h : float
+        Width and height (drawing units).
+    text : str
+        TeX label drawn inside.
+    """
     name: str
     x: float
     y: float
@@ -69,7 +81,13 @@ class Block:
     text: str
 
     def on_boundary(self, p) -> bool:
-        """Whether point ``p`` lies on the block's outline."""
+        """Whether point ``p`` lies on the block's outline.
+
+        Parameters
+        ----------
+        p : (float, float)
+            The point.
+        """
         x, y = p
         l, r, b, t = self.x - self.w / 2, self.x + self.w / 2, self.y - self.h / 2, self.y + self.h / 2
         on_v = (abs(x - l) < _TOL or abs(x - r) < _TOL) and b - _TOL <= y <= t + _TOL
@@ -80,7 +98,19 @@ class Block:
 @dataclass(frozen=True)
 class Sum:
     """A summing junction: a circle of radius ``r`` at ``(x, y)``; ``signs`` maps an inlet side
-    (``"top"``, ``"bottom"``, ``"left"``) to ``"+"`` or ``"-"``."""
+    (``"top"``, ``"bottom"``, ``"left"``) to ``"+"`` or ``"-"``.
+
+    Attributes
+    ----------
+    name : str
+        Name of the junction in the signal graph.
+    x, y : float
+        Centre (drawing units).
+    r : float
+        Radius (drawing units).
+    signs : tuple of (str, str)
+        Pairs (inlet side, ``"+"`` or ``"-"``).
+    """
     name: str
     x: float
     y: float
@@ -88,7 +118,13 @@ class Sum:
     signs: tuple = ()
 
     def on_boundary(self, p) -> bool:
-        """Whether point ``p`` lies on the circle."""
+        """Whether point ``p`` lies on the circle.
+
+        Parameters
+        ----------
+        p : (float, float)
+            The point.
+        """
         return abs(((p[0] - self.x) ** 2 + (p[1] - self.y) ** 2) ** 0.5 - self.r) < 1e-6
 
 
@@ -100,6 +136,17 @@ class Wire:
     (default: the longest), on ``side`` (``"top"``, ``"bottom"``, ``"left"``,
     ``"right"``; default above a horizontal and outside a vertical segment).
     A wire that starts on another wire is a branch of it (drawn with a dot).
+
+    Attributes
+    ----------
+    points : tuple of (float, float)
+        The corners, from source to target.
+    text : str
+        TeX label.
+    seg : int or None
+        Index of the labelled segment (None: the longest).
+    side : str or None
+        Side of the label (None: the default for the segment's direction).
     """
     points: tuple
     text: str = ""
@@ -109,7 +156,17 @@ class Wire:
 
 @dataclass(frozen=True)
 class Frame:
-    """A dashed rectangle grouping blocks, given by its corners, labelled at its top-left."""
+    """A dashed rectangle grouping blocks, given by its corners, labelled at its top-left.
+
+    Attributes
+    ----------
+    x0, y0 : float
+        One corner (drawing units).
+    x1, y1 : float
+        The opposite corner.
+    text : str
+        Label at the top-left.
+    """
     x0: float
     y0: float
     x1: float
@@ -119,7 +176,25 @@ class Frame:
 
 @dataclass(frozen=True)
 class Diagram:
-    """One block diagram: its parts, a caption and the size it is drawn at (inches)."""
+    """One block diagram: its parts, a caption and the size it is drawn at (inches).
+
+    Attributes
+    ----------
+    name : str
+        Key of the diagram in :data:`DIAGRAMS`.
+    caption : str
+        Caption in the book.
+    blocks : tuple of Block
+        The blocks.
+    wires : tuple of Wire
+        The signals.
+    sums : tuple of Sum
+        The summing junctions.
+    frames : tuple of Frame
+        The dashed groups.
+    size : (float, float)
+        Width and height of the drawing [in].
+    """
     name: str
     caption: str
     blocks: tuple
@@ -131,7 +206,17 @@ class Diagram:
 
 @dataclass(frozen=True)
 class Edge:
-    """One signal of the graph: from block ``source`` to block ``target`` (None: outside)."""
+    """One signal of the graph: from block ``source`` to block ``target`` (None: outside).
+
+    Attributes
+    ----------
+    source : str or None
+        Name of the block the signal leaves (None: an external input).
+    target : str or None
+        Name of the block it enters (None: an external output).
+    signal : str
+        The wire's label.
+    """
     source: str | None
     target: str | None
     signal: str
@@ -312,6 +397,11 @@ DIAGRAMS = tuple(_BUILDERS)
 def diagram(name: str) -> Diagram:
     """The :class:`Diagram` called ``name`` (one of :data:`DIAGRAMS`).
 
+    Parameters
+    ----------
+    name : str
+        One of :data:`DIAGRAMS`.
+
     Raises
     ------
     UsageError
@@ -353,9 +443,24 @@ def signal_graph(d: Diagram) -> list[Edge]:
     (an external input or output).  The label of a branch is that of the wire it
     leaves.
 
+    Parameters
+    ----------
+    d : Diagram
+        The diagram.
+
     Returns
     -------
     list of Edge
+
+    Examples
+    --------
+    >>> from mutext.diagrams import diagram, signal_graph
+    >>> for e in signal_graph(diagram("generalized_plant")):
+    ...     print(e.source, "->", e.target, e.signal)
+    None -> P $w$
+    P -> None $z$
+    P -> K $y$
+    K -> P $u$
     """
     edges = []
     for w in d.wires:

@@ -29,6 +29,23 @@ def frequency_grid(*systems, decades: float = 1.5, n: int = 800) -> np.ndarray:
     ``decades`` beyond the slowest and fastest nonzero pole and contains the
     imaginary parts of lightly damped poles, so resonance peaks are not missed
     (undamped poles: points 0.1 % either side).
+
+    Parameters
+    ----------
+    *systems : control.StateSpace
+        The systems whose poles the grid covers.
+    decades : float, optional
+        How far the grid reaches beyond the slowest and fastest pole.
+    n : int, optional
+        Number of log-spaced points.
+
+    Examples
+    --------
+    >>> from mutext.lti import ss
+    >>> from mutext.plots import frequency_grid
+    >>> w = frequency_grid(ss([[-10.0]], [[1.0]], [[1.0]], [[0.0]]), n=100)
+    >>> bool(w.min() < 1.0 and w.max() > 100.0)          # 1.5 decades either side of 10 rad/s
+    True
     """
     poles = [np.linalg.eigvals(np.asarray(s.A, float)) for s in map(as_ss, systems) if s.nstates]
     return response.frequency_grid(n=n, poles=np.concatenate(poles) if poles else (),
@@ -64,7 +81,22 @@ def bode_mag(ax, sys, omega, out_index: int = 0, in_index: int = 0, db: bool = T
 
 
 def bode_phase(ax, sys, omega, out_index: int = 0, in_index: int = 0, **kw):
-    """Plot the unwrapped phase (degrees) of one channel on ``ax``."""
+    """Plot the unwrapped phase (degrees) of one channel on ``ax``.
+
+    Parameters
+    ----------
+    ax : matplotlib.axes.Axes
+        The axes to draw on.
+    sys : control.StateSpace or as accepted by :func:`mutext.lti.as_ss`
+        The system.
+    omega : array_like
+        Frequencies in rad/s.
+
+    out_index, in_index : int, optional
+        Output and input of the channel.
+    **kw
+        Passed to :meth:`matplotlib.axes.Axes.semilogx`.
+    """
     G = freqresp(sys, omega)[out_index, in_index]
     ax.semilogx(omega, np.degrees(np.unwrap(np.angle(G))), **kw)
     ax.set_xlabel("frequency [rad/s]")
@@ -74,7 +106,22 @@ def bode_phase(ax, sys, omega, out_index: int = 0, in_index: int = 0, **kw):
 
 
 def sigma_plot(ax, sys, omega, db: bool = False, **kw):
-    """Plot the largest singular value of ``G(j w)`` on ``ax`` (absolute by default)."""
+    """Plot the largest singular value of ``G(j w)`` on ``ax`` (absolute by default).
+
+    Parameters
+    ----------
+    ax : matplotlib.axes.Axes
+        The axes to draw on.
+    sys : control.StateSpace or as accepted by :func:`mutext.lti.as_ss`
+        The system.
+    omega : array_like
+        Frequencies in rad/s.
+
+    db : bool, optional
+        Plot in dB instead of absolute.
+    **kw
+        Passed to :meth:`matplotlib.axes.Axes.semilogx`.
+    """
     s = sigma_max(sys, omega)
     ax.semilogx(omega, _db(s) if db else s, **kw)
     ax.set_xlabel("frequency [rad/s]")
@@ -97,6 +144,8 @@ def closed_loop_figure(CL, omega=None, P=None, input_names=None, output_names=No
         (control input left at zero) are drawn dashed for comparison.
     input_names, output_names : list of str, optional
         Axis labels (default: the system's signal names).
+    title : str, optional
+        Title of the figure.
 
     Returns
     -------
@@ -143,6 +192,15 @@ def closed_loop_figure(CL, omega=None, P=None, input_names=None, output_names=No
 def controller_figure(K, omega=None, title=None):
     """Bode magnitude and phase of a SISO controller (thesis Fig. 2.7 analogue).
 
+    Parameters
+    ----------
+    K : control.StateSpace or as accepted by :func:`mutext.lti.as_ss`
+        The SISO controller.
+    omega : array_like, optional
+        Frequencies in rad/s (default: :func:`frequency_grid` of ``K``).
+    title : str, optional
+        Title of the figure.
+
     Returns
     -------
     matplotlib.figure.Figure
@@ -172,6 +230,8 @@ def sigma_figure(CL, omega=None, levels=None, title=None):
         Frequencies in rad/s.
     levels : dict of str -> float, optional
         Horizontal lines to draw, e.g. ``{"optimal gamma": 1.0069}``.
+    title : str, optional
+        Title of the figure.
 
     Returns
     -------
@@ -327,6 +387,20 @@ def sideband_figure(frf, evidence, reference=None, title=None, band=None):
     the local response against the level the noise lets the test see.
     ``band`` = (f_min, f_max) in Hz shows only that band (sidebands are a few
     tenths of a percent of the response: over the whole sweep they do not show).
+
+    Parameters
+    ----------
+    frf : mutext.response.FRF
+        The measured sweep.
+    evidence : mutext.diagnose.SidebandEvidence
+        The result of :func:`mutext.diagnose.sideband_evidence` on it.
+    reference : array_like of complex, optional
+        A time-invariant model's response at ``frf.freq_hz``.
+    title : str, optional
+        Title of the figure.
+
+    band : (float, float), optional
+        Frequency band [Hz] shown.
     """
     plt = _plt()
     from matplotlib.lines import Line2D
@@ -376,6 +450,13 @@ def crack_identification_figure(out, title=None):
     ``out`` is the dict of :func:`mutext.demos.crack.solve` (or anything with
     its keys ``freqs_hz``, ``measured``, ``engineering``, ``controlled``,
     ``K``, ``D_rig``, ``D_mean``, ``first_mode_band_hz``).
+
+    Parameters
+    ----------
+    out : dict
+        The result of :func:`mutext.demos.crack.solve` (or a dict with its keys).
+    title : str, optional
+        Title of the figure.
     """
     plt = _plt()
     f = out["freqs_hz"]
@@ -399,7 +480,20 @@ def crack_identification_figure(out, title=None):
 
 
 def crack_figures(out, outdir) -> list[str]:
-    """Save the figures of ``mutext demo crack`` (identification, sidebands) in ``outdir``."""
+    """Save the figures of ``mutext demo crack`` (identification, sidebands) in ``outdir``.
+
+    Parameters
+    ----------
+    out : dict
+        The result of :func:`mutext.demos.crack.solve`.
+    outdir : str or path-like
+        Folder for the PNG files (created if missing).
+
+    Returns
+    -------
+    list of str
+        The files written.
+    """
     from .errors import ModelError
     from .response import FRF
     try:
@@ -425,7 +519,20 @@ def campbell_figure(cd, *, log_dec: bool = True, title=None, label_orders=(1, 2,
     """Campbell diagram of a :class:`mutext.rotor.CampbellDiagram`: whirl frequencies against speed
     (forward up-triangles, backward down-triangles), the excitation lines of its orders, the critical
     speeds found on them (circles; forward ones of ``label_orders`` labelled in rpm), and, with ``log_dec``,
-    the logarithmic decrement of every mode below."""
+    the logarithmic decrement of every mode below.
+
+    Parameters
+    ----------
+    cd : mutext.rotor.CampbellDiagram
+        The diagram's data (:func:`mutext.rotor.campbell`).
+    log_dec : bool, optional
+        Add the panel of logarithmic decrements.
+    title : str, optional
+        Title of the figure.
+
+    label_orders : sequence of int, optional
+        Orders whose forward critical speeds are labelled.
+    """
     plt = _plt()
     rpm = cd.speeds_rpm
     if log_dec:
@@ -475,7 +582,17 @@ def mode_shapes_figure(ms, *, marks=None, title=None):
     """Mode shapes of a :class:`mutext.rotor.ModeShapes` along the shaft: per mode the whirl envelope
     (the semi-major axis at each station, shaded) and the planar snapshot along the major axis
     (``ms.shape``, signs show the nodes); the title of each panel gives frequency, damping ratio, log decrement and whirl.
-    ``marks`` maps a station to a label (bearings, disks) drawn as vertical lines."""
+    ``marks`` maps a station to a label (bearings, disks) drawn as vertical lines.
+
+    Parameters
+    ----------
+    ms : mutext.rotor.ModeShapes
+        The modes (:func:`mutext.rotor.mode_shapes`).
+    marks : dict of int to str, optional
+        Station -> label drawn as a vertical line.
+    title : str, optional
+        Title of the figure.
+    """
     plt = _plt()
     n = ms.frequencies_hz.size
     fig, axes = plt.subplots(n, 1, figsize=(7.0, 1.7 * n + 0.6), sharex=True, squeeze=False)
@@ -506,7 +623,17 @@ def _probe_label(p):
 
 def unbalance_bode_figure(resp, *, critical=None, title=None):
     """Bode plot of a :class:`mutext.rotor.UnbalanceResponse`: amplitude [µm] and phase [deg] at every probe
-    against speed [rpm]; ``critical`` (a list of :class:`mutext.rotor.Crossing`) drawn as vertical lines."""
+    against speed [rpm]; ``critical`` (a list of :class:`mutext.rotor.Crossing`) drawn as vertical lines.
+
+    Parameters
+    ----------
+    resp : mutext.rotor.UnbalanceResponse
+        The response (:func:`mutext.rotor.unbalance_response`).
+    critical : list of mutext.rotor.Crossing, optional
+        Critical speeds drawn as vertical lines.
+    title : str, optional
+        Title of the figure.
+    """
     plt = _plt()
     fig, (a1, a2) = plt.subplots(2, 1, figsize=(7.0, 5.0), sharex=True)
     for j, p in enumerate(resp.probes):
@@ -531,7 +658,19 @@ def unbalance_bode_figure(resp, *, critical=None, title=None):
 
 def unbalance_polar_figure(resp, *, probe: int = 0, every=None, title=None):
     """Polar (Nyquist) plot of one probe of a :class:`mutext.rotor.UnbalanceResponse`: the complex 1x
-    amplitude [µm] as the speed rises, with a few speeds labelled in rpm."""
+    amplitude [µm] as the speed rises, with a few speeds labelled in rpm.
+
+    Parameters
+    ----------
+    resp : mutext.rotor.UnbalanceResponse
+        The response (:func:`mutext.rotor.unbalance_response`).
+    probe : int, optional
+        Index of the probe.
+    every : int, optional
+        Label every ``every``-th speed (default: about eight labels).
+    title : str, optional
+        Title of the figure.
+    """
     plt = _plt()
     P = 1e6 * resp.response[:, probe]
     fig, ax = plt.subplots(figsize=(5.2, 5.0))
@@ -552,7 +691,17 @@ def unbalance_polar_figure(resp, *, probe: int = 0, every=None, title=None):
 
 def orbit_figure(orbits, *, titles=None, title=None):
     """Orbits (:class:`mutext.rotor.Orbit`) side by side in µm: the path, the keyphasor mark at t = 0 (dot)
-    and the sense of travel (arrow)."""
+    and the sense of travel (arrow).
+
+    Parameters
+    ----------
+    orbits : iterable of mutext.rotor.Orbit
+        The orbits, one panel each.
+    titles : sequence of str, optional
+        Title of each panel.
+    title : str, optional
+        Title of the figure.
+    """
     plt = _plt()
     orbits = list(orbits)
     fig, axes = plt.subplots(1, len(orbits), figsize=(min(7.0, 3.3 * len(orbits)), 3.4), squeeze=False)
