@@ -706,7 +706,8 @@ def measure(system, in_port=0, out_port=0, freq_hz=None, *, noise=None, rng=None
 def measure_rotor(model, in_port: str, out_port: str, freq_hz=None, *, noise=None, rng=None,
                   harmonics: int = 6, cutoff_hz: float = 1000.0, revolutions: int = 40,
                   settle_s: float = 0.7, metadata: Mapping[str, str] | None = None,
-                  combination: Sequence[int] | None = None, speed_hz: float | None = None):
+                  combination: Sequence[int] | None = None, speed_hz: float | None = None,
+                  planes: str = "x"):
     r"""Virtual sine sweep of a finite-element rotor, as the rig's analyzer measures it.
 
     A rotor without a breathing crack is time-invariant: the measurement is
@@ -730,11 +731,21 @@ def measure_rotor(model, in_port: str, out_port: str, freq_hz=None, *, noise=Non
     applied to the much smaller combination response, which would make it
     look cleaner than it is).
 
+    With ``planes="xy"`` the rig excites in x and in y at the input's
+    station and measures x and y at the output's (two sensors, one sweep per
+    excitation plane): the planar FRF matrix :math:`[[H_{xx}, H_{xy}],
+    [H_{yx}, H_{yy}]]` of which the directional FRFs are made
+    (:mod:`mutext.rotor.directional`: forward and backward whirl, [Lee]_).
+    An exciter current drives the y axis with the force per ampere of the
+    port's axis (a magnetic bearing has both; the model declares one).  Each
+    of the four channels gets its own noise from one generator.
+
     Parameters
     ----------
     model : mutext.rotor.Rotor
     in_port, out_port : str
-        Port names (e.g. ``"i12"``, ``"x13"``).
+        Port names (e.g. ``"i12"``, ``"x13"``); with ``planes="xy"`` also
+        station numbers (a unit force; the displacement there).
     freq_hz : array_like, optional
         Default :func:`sweep_frequencies` (20-225 Hz, 0.5 Hz).
     noise, rng
@@ -746,14 +757,31 @@ def measure_rotor(model, in_port: str, out_port: str, freq_hz=None, *, noise=Non
         Orders :math:`k \ne 0` to record besides the excitation frequency.
     speed_hz : float, optional
         Running speed [Hz] (default: the model's).
+    planes : {"x", "xy"}
+        ``"x"`` (default): the one channel ``in_port -> out_port``;
+        ``"xy"``: the 2 x 2 planar matrix at their stations (not with
+        ``combination``).
 
     Returns
     -------
-    FRF, or list of FRF with ``combination``
+    FRF, list of FRF with ``combination``, or PlanarFRF with ``planes="xy"``
         With the ports' stations, directions and quantities and the speed.
         With ``combination``: the excitation-frequency FRF first, then one
         per order, whose metadata holds ``order`` and
-        ``response_frequency``.
+        ``response_frequency``.  With ``planes="xy"``: a
+        :class:`mutext.rotor.directional.PlanarFRF`
+        (``.directional()`` gives the dFRFs).
+
+    References
+    ----------
+    .. [Lee] C.-W. Lee, *Vibration Analysis of Rotors*, Kluwer, 1993, ch. 4.
+
+    Examples
+    --------
+    >>> from mutext.rotor import load_model, data_path
+    >>> P = measure_rotor(load_model(data_path("rotor.toml")), "i12", "x13", [150.0, 190.0], planes="xy")
+    >>> [[c.label for c in row] for row in P.channels]
+    [['i12->x13', 'i12y->x13'], ['i12->y13', 'i12y->y13']]
     """
     from .rotor.periodic import analyzer_combination, analyzer_frf, periodic_rotor
     f = sweep_frequencies() if freq_hz is None else np.asarray(freq_hz, dtype=float).ravel()
@@ -773,6 +801,14 @@ def measure_rotor(model, in_port: str, out_port: str, freq_hz=None, *, noise=Non
                 math.isfinite(speed_hz) and speed_hz >= 0):
             raise ModelError(f"measure_rotor: speed_hz must be a running speed >= 0 [Hz], got {speed_hz!r}")
         speed = 2.0 * math.pi * float(speed_hz)
+    if planes not in ("x", "xy"):
+        raise ModelError(f"measure_rotor: planes must be 'x' (one channel) or 'xy' (the planar 2 x 2 "
+                         f"matrix), got {planes!r}")
+    if planes == "xy":
+        if orders:
+            raise ModelError("measure_rotor: combination= records one channel; it does not go with planes='xy'")
+        return _measure_planar(model, in_port, out_port, f, speed, speed_hz, noise, rng, harmonics, cutoff_hz,
+                               revolutions, settle_s, metadata)
     pr = periodic_rotor(model, inputs=[in_port], outputs=[out_port], speed=speed)
     meta = {str(k): str(v) for k, v in (metadata or {}).items()}
     combos = {}
@@ -818,6 +854,41 @@ def measure_rotor(model, in_port: str, out_port: str, freq_hz=None, *, noise=Non
         c.input_name, c.output_name = ch.input_name, ch.output_name
         out.append(c)
     return out
+
+
+def _measure_planar(model, in_port, out_port, f, speed, speed_hz, noise, rng, harmonics, cutoff_hz,
+                    revolutions, settle_s, metadata):
+    """The planar 2 x 2 measurement of :func:`measure_rotor` (``planes="xy"``): the same analyzer on
+    a rotor with x and y ports at the two stations."""
+    from .rotor.directional import PlanarFRF, planar_rotor
+    from .rotor.periodic import analyzer_frf, harmonic_response
+    pr = planar_rotor(model, in_port, out_port, speed=speed)
+    meta = {str(k): str(v) for k, v in (metadata or {}).items()}
+    if pr.time_invariant():
+        # exact: the k = 0 harmonic of a time-invariant rotor is its frequency response
+        H = harmonic_response(pr, f, harmonics=0)(0)
+        meta.setdefault("analyzer", "time-invariant model: exact frequency response")
+    else:
+        red = pr.reduce(cutoff_hz, band_hz=(float(f.min()), float(f.max())))
+        H = analyzer_frf(red, f, harmonics=harmonics, revolutions=revolutions, settle_s=settle_s).H
+        meta.update({"analyzer": f"stepped sine, {revolutions} revolutions per correlation, "
+                                 f"{settle_s:g} s settling; harmonic balance N = {harmonics}",
+                     "breathing": ", ".join(f"{c.name} {c.law}" for c in pr.cracks),
+                     "reduction_error": f"{red.reduction_error:.3g}"})
+    gen = rng if isinstance(rng, np.random.Generator) else np.random.default_rng(rng)
+    F = float(speed_hz) if speed_hz is not None else (pr.speed / (2 * math.pi) if pr.speed else None)
+    rows = []
+    for i, o in enumerate(pr.outputs):
+        row = []
+        for j, q in enumerate(pr.inputs):
+            si, di, qi = pr.ports[q]
+            so, do, _ = pr.ports[o]
+            ch = FRF(freq_hz=f.copy(), response=H[i, j], input_station=si, output_station=so,
+                     input_quantity=qi, output_quantity="displacement", speed_hz=F, metadata=dict(meta),
+                     input_direction=di, output_direction=do, input_name=q, output_name=o)
+            row.append(with_noise(ch, noise, rng=gen))
+        rows.append(tuple(row))
+    return PlanarFRF(tuple(rows))
 
 
 def with_noise(frf: FRF, noise=None, *, rng=None) -> FRF:

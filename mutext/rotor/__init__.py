@@ -47,7 +47,11 @@ periodic
 simulate
     Time simulation of a Jeffcott rotor with a breathing crack.
 frf_channels
-    Measured FRFs as channels of a model (input column, output DOF, speed).
+    Measured FRFs as channels of a model (input column, output DOF, speed);
+    the x-y port pair of a planar FRF (:func:`~mutext.rotor.frf_channels.planar_ports`).
+directional
+    :class:`PlanarFRF` (the 2x2 x-y FRF matrix) and :func:`directional_frf`: forward and backward
+    whirl dFRFs (Lee 1993), :func:`whirl_peaks`.
 sensitivity
     FRFs and their exact parameter derivatives (adjoint, Daleckii-Krein).
 tuning
@@ -76,6 +80,7 @@ from .orbits import Ellipse, Orbit, ellipse, orbit
 from .unbalance import UnbalanceResponse, run_up, unbalance_response
 from .periodic_orbit import PeriodicResponse, periodic_unbalance_response
 from .sparse_modal import sparse_modes
+from .directional import DirectionalFRF, PlanarFRF, WhirlPeak, directional_frf, planar_rotor, whirl_peaks
 from .units import rad_s_to_rpm, rpm_to_rad_s
 from .reduction import Reduction, balanced_truncation, hankel_singular_values, modal_truncation, reduction_error
 from .tuning import FRFSensitivity, TuneResult, frf_sensitivity, model_response, tune
@@ -92,6 +97,7 @@ __all__ = [
     "CampbellDiagram", "Crossing", "campbell", "ModeShapes", "mode_shapes", "Ellipse", "Orbit", "ellipse", "orbit",
     "UnbalanceResponse", "run_up", "unbalance_response", "rpm_to_rad_s", "rad_s_to_rpm",
     "PeriodicResponse", "periodic_unbalance_response", "sparse_modes",
+    "DirectionalFRF", "PlanarFRF", "WhirlPeak", "directional_frf", "planar_rotor", "whirl_peaks",
 ]
 
 

@@ -7,6 +7,12 @@ at a DOF for a force input) and the output DOF.  :func:`select_points` thins
 a long sweep for a fit.  Shared by the tuning objective
 (:mod:`mutext.rotor.tuning`), the sensitivities
 (:mod:`mutext.rotor.sensitivity`) and the diagnosis.
+
+:func:`planar_ports` resolves a two-plane channel pair (excitation in x and
+y at one station, displacement in x and y at another) for the planar FRF
+matrix that the virtual rig records (:func:`mutext.rig.measure_rotor` with
+``planes="xy"``) and the directional FRFs
+(:mod:`mutext.rotor.directional`) are made of.
 """
 from __future__ import annotations
 
@@ -20,7 +26,7 @@ import numpy as np
 from ..errors import ModelError
 from ..response import FRF
 
-__all__ = ["select_points"]
+__all__ = ["select_points", "PlanarPorts", "planar_ports"]
 
 
 def _as_model(model):
@@ -168,3 +174,142 @@ def _groups(channels: Sequence[_Channel]) -> dict:
     for ch in channels:
         g.setdefault(ch.speed, []).append(2.0 * np.pi * ch.freq_hz)
     return {s: np.unique(np.concatenate(ws)) for s, ws in g.items()}
+
+
+# ----------------------------------------------------------------------------
+# two-plane channels
+# ----------------------------------------------------------------------------
+
+@dataclass(frozen=True)
+class PlanarPorts:
+    r"""Excitation in x and y at one station, displacement in x and y at another.
+
+    Attributes
+    ----------
+    input_station, output_station : int
+        Stations (1-based).
+    input_quantity : {"force", "current"}
+        Unit of the inputs: N for a force, A for an exciter current.
+    B : ndarray, shape (ndof, 2)
+        Input columns, x first: a unit force, or the exciter's force per
+        ampere, on the station's :math:`u` and :math:`v` DOFs.
+    Cy : ndarray, shape (2, ndof)
+        Output rows, x first: the station's :math:`u` and :math:`v`.
+    inputs, outputs : list of str
+        Names ``[x, y]`` of the two inputs and the two outputs.
+    ports : dict
+        Name -> ``(station, direction, quantity)``, as
+        :attr:`mutext.response.FRFMatrix.ports`.
+    """
+    input_station: int
+    output_station: int
+    input_quantity: str
+    B: np.ndarray
+    Cy: np.ndarray
+    inputs: list
+    outputs: list
+    ports: dict
+
+
+def _twin_name(ports, node, label, gain, base_name, base_label, kind):
+    """Name of the port at ``node`` in plane ``label``: the model's own port there (same gain for an
+    input) if it has one, else one made from the given port's name (``F12 -> F12y``, ``x13 -> y13``)."""
+    if label == base_label:
+        return base_name
+    for q in ports:
+        if q.node == node and q.direction in (label, {"u": "x", "v": "y"}[label]) and \
+                (kind == "output" or q.gain == gain):
+            return q.name
+    if kind == "output":
+        return ("x" if label == "u" else "y") + str(node)
+    if label == "v":
+        return base_name + "y"
+    return base_name[:-1] if base_name.endswith("y") and len(base_name) > 1 else base_name + "x"
+
+
+def planar_ports(model, in_port, out_port, *, values=None) -> PlanarPorts:
+    r"""The two-plane input and output pair of a rotor for the planar FRF matrix.
+
+    Parameters
+    ----------
+    model : mutext.rotor.Rotor
+        A two-plane rotor (``planes = 2``).
+    in_port : str or int
+        An input port name (``"i12"``, ``"F2"``): excitation at its station,
+        by the same means in both planes -- a force [N], or an exciter
+        current [A] with the port's force per ampere in x and in y (an
+        active magnetic bearing drives both axes; the model file declares
+        one, and the other is taken to have the same gain) -- or a station
+        number: a unit force there.
+    out_port : str or int
+        An output port name (``"x13"``) or a station number: the station's
+        displacement in x and y.
+    values : mapping or array, optional
+        Parameter values (default: nominal), for an exciter's gain.
+
+    Returns
+    -------
+    PlanarPorts
+
+    Raises
+    ------
+    ModelError
+        The model is not a two-plane rotor, a port name is unknown, a port
+        is not a translational force/displacement (a moment, a rotation),
+        or a station is outside the rotor.
+
+    Examples
+    --------
+    >>> from mutext.rotor import load_model, data_path
+    >>> from mutext.rotor.frf_channels import planar_ports
+    >>> pp = planar_ports(load_model(data_path("rotor.toml")), "i12", 13)
+    >>> pp.inputs, pp.outputs, pp.input_quantity
+    (['i12', 'i12y'], ['x13', 'y13'], 'current')
+    """
+    model = _as_model(model)
+    lay = model.layout
+    if lay.kind != "rotor":
+        raise ModelError(f"{model.name}: a planar (x-y) FRF needs a two-plane rotor (planes = 2); this "
+                         f"model has the '{lay.kind}' layout")
+    n = lay.ndof
+    B = np.zeros((n, 2))
+    Cy = np.zeros((2, n))
+    if isinstance(in_port, str):
+        if in_port not in model.input_names:
+            raise ModelError(f"{model.name}: unknown input '{in_port}' (inputs: {', '.join(model.input_names)})")
+        j = model.input_names.index(in_port)
+        port = model.inputs[j]
+        base = lay.label(port.direction)
+        if base not in ("u", "v"):
+            raise ModelError(f"{model.name}: input '{in_port}' acts on '{port.direction}' (a moment); a planar "
+                             f"FRF needs a force or an exciter current in x or y")
+        s_in, gain_name = port.node, port.gain
+        b = float(np.asarray(model.input_matrix(values))[lay.dof(s_in, base), j])
+        qty = "current" if gain_name is not None else "force"
+        ins = [_twin_name(model.inputs, s_in, lab, gain_name, in_port, base, "input") for lab in ("u", "v")]
+    else:
+        s_in = lay.check_node(in_port if not isinstance(in_port, np.integer) else int(in_port), "in_port")
+        b, qty, base = 1.0, "force", "u"
+        ins = [f"F{s_in}", f"F{s_in}y"]
+    if isinstance(out_port, str):
+        if out_port not in model.output_names:
+            raise ModelError(f"{model.name}: unknown output '{out_port}' (outputs: "
+                             f"{', '.join(model.output_names)})")
+        port = model.outputs[model.output_names.index(out_port)]
+        obase = lay.label(port.direction)
+        if obase not in ("u", "v"):
+            raise ModelError(f"{model.name}: output '{out_port}' is the rotation '{port.direction}'; a planar "
+                             f"FRF needs a displacement in x or y")
+        s_out = port.node
+        outs = [_twin_name(model.outputs, s_out, lab, None, out_port, obase, "output") for lab in ("u", "v")]
+    else:
+        s_out = lay.check_node(out_port if not isinstance(out_port, np.integer) else int(out_port), "out_port")
+        outs = [f"x{s_out}", f"y{s_out}"]
+    if len(set(ins)) != 2 or len(set(outs)) != 2:  # pragma: no cover - the naming keeps them apart
+        raise ModelError(f"{model.name}: the x and y ports are not told apart ({ins}, {outs})")
+    for k, lab in enumerate(("u", "v")):
+        B[lay.dof(s_in, lab), k] = b
+        Cy[k, lay.dof(s_out, lab)] = 1.0
+    ports = {ins[0]: (s_in, "x", qty), ins[1]: (s_in, "y", qty),
+             outs[0]: (s_out, "x", "displacement"), outs[1]: (s_out, "y", "displacement")}
+    return PlanarPorts(s_in, s_out, qty, B, Cy, ins, outs, ports)
