@@ -25,7 +25,17 @@ KINDS = (("stiffness", "mass", "damping", "crack", "bearing") + _absorber.KINDS 
 
 
 def hypotheses(model, frfs=None, *, stations=None) -> list[Hypothesis]:
-    """The hypotheses :func:`diagnose` tests on ``model`` (given the measured channels ``frfs``)."""
+    """The hypotheses :func:`diagnose` tests on ``model`` (given the measured channels ``frfs``).
+
+    Parameters
+    ----------
+    model : Structure, Rotor or str
+        The engineering model, or the path of its model file.
+    frfs : sequence of mutext.response.FRF, optional
+        The measured channels (adds the measurement-chain hypotheses).
+    stations : sequence of int, optional
+        Stations at which rotor and crack hypotheses are formed (default: all).
+    """
     if isinstance(model, (str, os.PathLike)):
         model = load_model(model)
     if model.layout.kind == "lumped":

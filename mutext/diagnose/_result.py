@@ -18,6 +18,41 @@ class Finding:
     (lower is better); ``delta_chi2`` the improvement over *none*;
     ``significant`` whether it passes the false-alarm test (never when the size
     sits at a bound of its range: ``at_bound``).
+
+    Attributes
+    ----------
+    kind : str
+        Kind of the hypothesis (see :data:`KINDS`), or ``"none"``.
+    station : int or None
+        1-based station or mass index.
+    element : str or None
+        Element changed or added.
+    value : float
+        The fitted size (SI, a depth ratio or a factor).
+    unit : str
+        Unit of ``value``.
+    std : float
+        Standard uncertainty of ``value``.
+    score : float
+        Information criterion (lower is better).
+    delta_chi2 : float
+        Improvement of :math:`\chi^2` over *none*.
+    description : str
+        The hypothesis in words.
+    significant : bool
+        Passes the false-alarm test.
+    refit : bool
+        Size refitted on the extended model file itself.
+    new_value : float or None
+        The element's value in the extended model (an existing element changed).
+    hypothesis : Hypothesis or None
+        The hypothesis fitted.
+    at_bound : bool
+        The size sits at a bound of its range.
+    values : tuple or None
+        The fitted vector of a k-parameter hypothesis.
+    stds : tuple or None
+        The standard uncertainty of each of ``values``.
     """
     kind: str
     station: int | None
@@ -58,7 +93,13 @@ class Finding:
         return f"{self.description}: {self.size_text()}{slip}{bound}"
 
     def size_text(self, std: bool = True) -> str:
-        """The size with its unit (a factor as x1.05, a crack as a/D, a delay in ms)."""
+        """The size with its unit (a factor as x1.05, a crack as a/D, a delay in ms).
+
+        Parameters
+        ----------
+        std : bool, optional
+            Append the standard uncertainty (``+- ...``).
+        """
         if self.kind == "none":
             return "-"
         if self.values is not None:
@@ -100,7 +141,23 @@ def _unit_slip(g: float, std: float) -> str:
 
 @dataclass
 class ResonanceRow:
-    """Measured against modelled resonance of one channel."""
+    """Measured against modelled resonance of one channel.
+
+    Attributes
+    ----------
+    channel : str
+        The channel.
+    measured_hz, measured_hz_std : float
+        Measured resonance frequency [Hz] and its standard uncertainty (NaN: not reliable).
+    model_hz : float
+        The model's resonance frequency [Hz].
+    measured_damping, measured_damping_std : float
+        Measured damping ratio and its standard uncertainty.
+    model_damping : float
+        The model's damping ratio.
+    measured_peak, model_peak : float
+        Peak magnitudes (output unit per input unit).
+    """
     channel: str
     measured_hz: float
     measured_hz_std: float
@@ -124,7 +181,25 @@ class ResonanceRow:
 
 @dataclass
 class ChannelComparison:
-    """Model against data in one channel (SI units)."""
+    """Model against data in one channel (SI units).
+
+    Attributes
+    ----------
+    label : str
+        The channel (``input->output``).
+    source : str
+        File the data came from.
+    freq_hz : ndarray
+        Frequencies [Hz].
+    measured : complex ndarray
+        The measured response.
+    before : complex ndarray
+        The engineering model's response.
+    after : complex ndarray or None
+        The extended model's response.
+    role : str
+        ``"fit"`` or ``"validate"`` (held out).
+    """
     label: str
     source: str
     freq_hz: np.ndarray
@@ -145,7 +220,73 @@ class ChannelComparison:
 
 @dataclass
 class Diagnosis:
-    """Result of :func:`diagnose` (see its docstring); ``as_dict()`` is the ``--json`` object."""
+    """Result of :func:`diagnose` (see its docstring); ``as_dict()`` is the ``--json`` object.
+
+    Attributes
+    ----------
+    model_name : str
+        Name of the engineering model.
+    model_source : str or None
+        Its file.
+    noise : float
+        Relative noise level estimated from the data (standard deviation of the complex log residual).
+    findings : list of Finding
+        Every hypothesis tested, best first (*none* included).
+    verdict : Finding
+        The first effect selected (or *none*).
+    ambiguous_with : list of Finding
+        Findings the data cannot tell from the verdict.
+    separating_sensor : int or None
+        Station whose response would separate them best.
+    error_before, error_after : dict
+        Held-out error of the engineering and of the extended model: ``{"rel": ..., "db": ...}``.
+    gain : float
+        ``error_before["rel"] / error_after["rel"]``.
+    held_out : str
+        Which data were held out, in words.
+    channels : list of ChannelComparison
+        Model against data per channel.
+    resonances : list of ResonanceRow
+        Measured against modelled resonances.
+    summary : list of str
+        The comparison in a few sentences.
+    threshold : float
+        The :math:`\Delta\chi^2` an effect must exceed (Bonferroni at ``alpha``).
+    alpha : float
+        The false-alarm rate.
+    n_hypotheses : int
+        Number of hypotheses tested.
+    extended_model_text : str or None
+        The extended model file's text.
+    seconds : float
+        Wall time of the diagnosis.
+    notes : list of str
+        Remarks on the data and the fit.
+    n_residuals : int
+        Number of real residuals of the fit (two per complex point).
+    extended_model : str or None
+        Path of the written extended model.
+    mbi : dict or None
+        The model-based identification at the finding, when asked for.
+    sidebands : dict or None
+        Sideband evidence when the data were taken at speed (rotors).
+    breathing : dict or None
+        A crack turning with the shaft, fitted when the sidebands call for it.
+    status : str
+        ``"explained"``, ``"partly explained"`` or ``"not explained"``.
+    effects : list of Finding
+        The accepted findings, in the order of selection.
+    fit_quality : FitQuality or None
+        Lack-of-fit test of the final model on the fitted data.
+    noise_reference : NoiseReference or None
+        The model-free noise reference.
+    unmatched : dict or None
+        Resonances without a partner: ``{"measured": [...], "model": [...]}``.
+    localized : dict or None
+        Where an unexplained misfit lives (:mod:`mutext.diagnose._localize`).
+    held_quality : FitQuality or None
+        Lack-of-fit test of the final model on the held-out data.
+    """
     model_name: str
     model_source: str | None
     noise: float
@@ -253,7 +394,13 @@ class Diagnosis:
         }
 
     def misfit_left(self, finding: Finding) -> float:
-        """The misfit after ``finding``, in units of what noise alone leaves (about 1 for the right model)."""
+        """The misfit after ``finding``, in units of what noise alone leaves (about 1 for the right model).
+
+        Parameters
+        ----------
+        finding : Finding
+            One of ``findings``.
+        """
         none = next(f for f in self.findings if f.kind == "none")
         return (none.score - finding.delta_chi2) / max(self.n_residuals, 1)
 

@@ -85,7 +85,31 @@ __all__ = ["SidebandCandidate", "CombinationTest", "SidebandEvidence", "sideband
 
 @dataclass
 class SidebandCandidate:
-    """One place where a sideband of order ``k`` of the mode at ``mode_hz`` would appear."""
+    """One place where a sideband of order ``k`` of the mode at ``mode_hz`` would appear.
+
+    Attributes
+    ----------
+    mode_hz : float
+        The mode's frequency [Hz].
+    k : int
+        Order of the sideband (at ``mode_hz - k F``).
+    freq_hz : float
+        Where the sideband would appear [Hz].
+    delta_chi2 : float
+        Improvement of the local fit with the sideband.
+    p_value : float
+        Its p-value under noise only.
+    relative_size : float
+        Size relative to the local response.
+    snr : float
+        Size over what the noise lets the test see.
+    found : bool
+        Significant at the threshold.
+    masked : bool
+        Not tested: too close to a mode (three half-power bandwidths) or too few samples around it.
+    unpaired : bool
+        Found, but its mirror was testable and not found (not counted).
+    """
     mode_hz: float
     k: int
     freq_hz: float
@@ -156,6 +180,12 @@ class SidebandEvidence:
     detectable : float
         The smallest sideband (relative to the local response) this noise
         level lets the test see, roughly.
+    combination : list
+        The tests of the combination-frequency channels, when the data hold any.
+    source : str
+        What the verdict rests on: ``"stepped sine"`` or ``"combination"``.
+    stepped_sine_verdict : str
+        The stepped-sine sideband test's own verdict.
     """
     candidates: list
     modes: list

@@ -8,7 +8,19 @@ import numpy as np
 
 @dataclass(frozen=True)
 class Param:
-    """One parameter of a k-parameter hypothesis: name, unit, bounds and typical size (SI)."""
+    """One parameter of a k-parameter hypothesis: name, unit, bounds and typical size (SI).
+
+    Attributes
+    ----------
+    name : str
+        Name of the parameter (e.g. ``"mass"``).
+    unit : str
+        Its unit.
+    lower, upper : float
+        Bounds of the fit (SI).
+    scale : float
+        Typical size (SI), the scale of the fit's variable.
+    """
     name: str
     unit: str
     lower: float
@@ -73,6 +85,10 @@ class Hypothesis:
         parameters (a pedestal of no mass is a softer spring): with several
         effects, the simpler reading replaces it when the data cannot tell
         them apart (:func:`mutext.diagnose._core._simplify`).
+    crack : callable or None
+        Depth ratio -> stiffness change on ``dofs`` (crack hypotheses).
+    run : tuple of str
+        The springs of a run, in chain order (distributed kinds).
     """
     kind: str
     station: int | None
@@ -109,7 +125,17 @@ class Hypothesis:
 
 def local_change(h: Hypothesis, theta: float, w) -> np.ndarray:
     """The change of dynamic stiffness of a local hypothesis on its DOFs at size ``theta``, per frequency:
-    ``(w.size, |U|, |U|)`` (a crack's exact stiffness change, else ``theta (1, j w, -w^2)[order] S``)."""
+    ``(w.size, |U|, |U|)`` (a crack's exact stiffness change, else ``theta (1, j w, -w^2)[order] S``).
+
+    Parameters
+    ----------
+    h : Hypothesis
+        A local hypothesis (a pattern, a crack or a k-parameter change).
+    theta : float or ndarray
+        Its size (a vector for k > 1 parameters).
+    w : array_like
+        Frequencies [rad/s].
+    """
     w = np.asarray(w, float)
     if h.change is not None:
         return np.asarray(h.change(np.asarray(theta, float), w), complex)

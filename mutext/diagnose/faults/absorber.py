@@ -47,7 +47,15 @@ START_ZETA = 0.05
 
 
 def impedance(theta, w) -> np.ndarray:
-    r"""The absorber's impedance at the host, :math:`Z(\omega)` above, for ``theta = (m_a, k_a, c_a)``."""
+    r"""The absorber's impedance at the host, :math:`Z(\omega)` above, for ``theta = (m_a, k_a, c_a)``.
+
+    Parameters
+    ----------
+    theta : (3,) array_like
+        Absorber mass [kg], stiffness [N/m] and damping [N s/m].
+    w : array_like
+        Frequencies [rad/s].
+    """
     ma, ka, ca = (float(x) for x in theta)
     w = np.asarray(w, float)
     s = ka + 1j * w * ca
@@ -59,7 +67,13 @@ def _change(theta, w):
 
 
 def candidates(model) -> list[Hypothesis]:
-    """An absorber at every mass of a lumped chain ``model`` (none for a rotor)."""
+    """An absorber at every mass of a lumped chain ``model`` (none for a rotor).
+
+    Parameters
+    ----------
+    model : Structure
+        The engineering model (a lumped chain; a rotor gives none).
+    """
     lay = model.layout
     if lay.kind != "lumped":
         return []
@@ -89,7 +103,19 @@ def candidates(model) -> list[Hypothesis]:
 
 def write(mf, finding, model, note: str) -> None:
     """Write the absorber into the model file ``mf``: a ``[[mass]]``, and a ``[[spring]]`` and a ``[[damper]]``
-    between it and its host (:class:`~mutext.rotor.model_writer.ModelFile`)."""
+    between it and its host (:class:`~mutext.rotor.model_writer.ModelFile`).
+
+    Parameters
+    ----------
+    mf : mutext.rotor.model_writer.ModelFile
+        The model file being extended (edited in place).
+    finding : Finding
+        The accepted finding (its hypothesis and fitted size).
+    model : Structure or Rotor
+        The engineering model the finding refers to.
+    note : str
+        Comment written next to the change in the file.
+    """
     h = finding.hypothesis
     ma, ka, ca = (float(x) for x in finding.values)
     host = model.layout.node_names[h.station - 1]

@@ -37,12 +37,27 @@ DELAY_RANGE = (-0.01, 0.01)
 
 
 def is_log_sized(h: Hypothesis) -> bool:
-    """Whether the size is a factor (compared in log terms), not a delay or a mass."""
+    """Whether the size is a factor (compared in log terms), not a delay or a mass.
+
+    Parameters
+    ----------
+    h : Hypothesis
+        A measurement-chain hypothesis (``h.gain`` set).
+    """
     return h.gain is not None and h.gain[0] not in ("delay", "sensor_mass")
 
 
 def hits(h: Hypothesis, ch) -> bool:
-    """Whether the effect acts on channel ``ch``."""
+    """Whether the effect acts on channel ``ch``.
+
+    Parameters
+    ----------
+    h : Hypothesis
+        A measurement-chain hypothesis (``h.gain`` set).
+
+    ch : channel
+        A resolved measured channel (its ``out_dof``, ``in_spec``, ``frf``).
+    """
     what, key = h.gain
     if what == "sensor_mass":
         return True
@@ -56,7 +71,22 @@ def hits(h: Hypothesis, ch) -> bool:
 def factor(h: Hypothesis, ch, f_hz, theta: float, Roo=None):
     """The factor on channel ``ch`` at ``f_hz``, and its derivative in ``theta`` (None, None if not hit).
 
-    ``Roo``: the engineering model's direct receptance at the channel's output (a sensor's mass only)."""
+    ``Roo``: the engineering model's direct receptance at the channel's output (a sensor's mass only).
+
+    Parameters
+    ----------
+    h : Hypothesis
+        A measurement-chain hypothesis (``h.gain`` set).
+
+    ch : channel
+        A resolved measured channel.
+    f_hz : array_like
+        Frequencies [Hz].
+    theta : float
+        Size of the effect (a factor, a delay [s] or a mass [kg]).
+    Roo : array_like, optional
+        Direct receptance [m/N] of the model at the channel's output (a sensor's mass only).
+    """
     if not hits(h, ch):
         return None, None
     if h.gain[0] == "sensor_mass":
@@ -73,7 +103,22 @@ def factor(h: Hypothesis, ch, f_hz, theta: float, Roo=None):
 
 
 def fit(h: Hypothesis, chans, H0s, meas, freqs):
-    """Closed-form size: a list of candidate sizes (the best by the caller's residual)."""
+    """Closed-form size: a list of candidate sizes (the best by the caller's residual).
+
+    Parameters
+    ----------
+    h : Hypothesis
+        A measurement-chain hypothesis (``h.gain`` set).
+
+    chans : sequence of channel
+        The resolved measured channels.
+    H0s : sequence of complex ndarray
+        The engineering model's response per channel.
+    meas : sequence of complex ndarray
+        The measured response per channel.
+    freqs : sequence of ndarray
+        Frequencies [Hz] per channel.
+    """
     r, w = [], []
     for ch, H0, m, f in zip(chans, H0s, meas, freqs):
         if hits(h, ch):
@@ -93,7 +138,15 @@ def fit(h: Hypothesis, chans, H0s, meas, freqs):
 
 
 def candidates(model, channels) -> list[Hypothesis]:
-    """Every measurement-chain hypothesis for the measured ``channels``."""
+    """Every measurement-chain hypothesis for the measured ``channels``.
+
+    Parameters
+    ----------
+    model : Structure or Rotor
+        The engineering model.
+    channels : sequence of channel
+        The resolved measured channels.
+    """
     out = []
     seen_out, seen_in = set(), set()
     for ch in channels:

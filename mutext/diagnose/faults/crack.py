@@ -28,7 +28,15 @@ KINDS = ("crack",)
 
 
 def candidates(model, stations=None) -> list[Hypothesis]:
-    """A crack in shaft element s (between stations s and s+1), depth ratio in [0, 0.5]."""
+    """A crack in shaft element s (between stations s and s+1), depth ratio in [0, 0.5].
+
+    Parameters
+    ----------
+    model : Rotor
+        The engineering model (a rotor).
+    stations : sequence of int, optional
+        Stations to consider (default: all).
+    """
     lay = model.layout
     out = []
     shafts = {el.nodes[0]: el for el in model.elements if type(el).__name__ == "ShaftElement"}
@@ -60,5 +68,17 @@ def candidates(model, stations=None) -> list[Hypothesis]:
 
 
 def write(mf, finding, model, note: str) -> None:
-    """Write the crack into the model file ``mf`` (:class:`~mutext.rotor.model_writer.ModelFile`)."""
+    """Write the crack into the model file ``mf`` (:class:`~mutext.rotor.model_writer.ModelFile`).
+
+    Parameters
+    ----------
+    mf : mutext.rotor.model_writer.ModelFile
+        The model file being extended (edited in place).
+    finding : Finding
+        The accepted finding (its hypothesis and fitted size).
+    model : Structure or Rotor
+        The engineering model the finding refers to.
+    note : str
+        Comment written next to the change in the file.
+    """
     mf.append("crack", {"station": finding.hypothesis.station, "depth_ratio": float(finding.value)}, note)

@@ -36,7 +36,13 @@ RANGE = (-0.95, 2.0)
 
 
 def runs(model) -> list:
-    """Runs of two or more consecutive springs of a chain, each a list of Spring elements in chain order."""
+    """Runs of two or more consecutive springs of a chain, each a list of Spring elements in chain order.
+
+    Parameters
+    ----------
+    model : Structure
+        A lumped chain.
+    """
     n = model.layout.n_nodes
     springs = [el for el in model.elements if isinstance(el, Spring)]
 
@@ -64,7 +70,13 @@ def runs(model) -> list:
 
 
 def candidates(model) -> list[Hypothesis]:
-    """A common relative stiffness change of every run of consecutive springs (lumped chains)."""
+    """A common relative stiffness change of every run of consecutive springs (lumped chains).
+
+    Parameters
+    ----------
+    model : Structure
+        The engineering model (a lumped chain; a rotor gives none).
+    """
     lay = model.layout
     if lay.kind != "lumped":
         return []
@@ -90,7 +102,19 @@ def candidates(model) -> list[Hypothesis]:
 
 
 def write(mf, finding, model, note: str) -> None:
-    """Every spring of the run at ``(1 + theta)`` times its stiffness in the model file ``mf``."""
+    """Every spring of the run at ``(1 + theta)`` times its stiffness in the model file ``mf``.
+
+    Parameters
+    ----------
+    mf : mutext.rotor.model_writer.ModelFile
+        The model file being extended (edited in place).
+    finding : Finding
+        The accepted finding (its hypothesis and fitted size).
+    model : Structure or Rotor
+        The engineering model the finding refers to.
+    note : str
+        Comment written next to the change in the file.
+    """
     h = finding.hypothesis
     f = 1.0 + float(finding.value)
     for name in h.run:

@@ -40,7 +40,13 @@ TABLE = {"stiffness": ("spring", "stiffness"), "damping": ("damper", "damping"),
 
 
 def candidates(model) -> list[Hypothesis]:
-    """Every lumped-element hypothesis of a chain ``model``."""
+    """Every lumped-element hypothesis of a chain ``model``.
+
+    Parameters
+    ----------
+    model : Structure
+        The engineering model (a lumped chain; a rotor gives none).
+    """
     lay = model.layout
     n = lay.n_nodes
     names = lay.node_names
@@ -88,7 +94,19 @@ def candidates(model) -> list[Hypothesis]:
 
 
 def write(mf, finding, model, note: str) -> None:
-    """Write ``finding`` into the model file ``mf`` (:class:`~mutext.rotor.model_writer.ModelFile`)."""
+    """Write ``finding`` into the model file ``mf`` (:class:`~mutext.rotor.model_writer.ModelFile`).
+
+    Parameters
+    ----------
+    mf : mutext.rotor.model_writer.ModelFile
+        The model file being extended (edited in place).
+    finding : Finding
+        The accepted finding (its hypothesis and fitted size).
+    model : Structure or Rotor
+        The engineering model the finding refers to.
+    note : str
+        Comment written next to the change in the file.
+    """
     h = finding.hypothesis
     table, key = TABLE[h.kind]
     if h.added:

@@ -37,7 +37,13 @@ START_RATIOS = (0.3, 3.0, 30.0)
 
 
 def change_of(kg: float):
-    """The change of dynamic stiffness of a spring ``kg`` to ground set on a pedestal, as ``f(theta, w)``."""
+    """The change of dynamic stiffness of a spring ``kg`` to ground set on a pedestal, as ``f(theta, w)``.
+
+    Parameters
+    ----------
+    kg : float
+        Stiffness [N/m] of the spring to ground.
+    """
     def change(theta, w):
         mp, kp = (float(x) for x in theta)
         w = np.asarray(w, float)
@@ -46,7 +52,13 @@ def change_of(kg: float):
 
 
 def candidates(model) -> list[Hypothesis]:
-    """A pedestal under every spring to ground of a lumped chain ``model``."""
+    """A pedestal under every spring to ground of a lumped chain ``model``.
+
+    Parameters
+    ----------
+    model : Structure or Rotor
+        The engineering model.
+    """
     lay = model.layout
     if lay.kind != "lumped":
         return []
@@ -77,7 +89,19 @@ def candidates(model) -> list[Hypothesis]:
 
 
 def write(mf, finding, model, note: str) -> None:
-    """The pedestal into the model file ``mf``: its mass, the spring moved onto it, its spring to ground."""
+    """The pedestal into the model file ``mf``: its mass, the spring moved onto it, its spring to ground.
+
+    Parameters
+    ----------
+    mf : mutext.rotor.model_writer.ModelFile
+        The model file being extended (edited in place).
+    finding : Finding
+        The accepted finding (its hypothesis and fitted size).
+    model : Structure or Rotor
+        The engineering model the finding refers to.
+    note : str
+        Comment written next to the change in the file.
+    """
     h = finding.hypothesis
     mp, kp = (float(x) for x in finding.values)
     host = model.layout.node_names[h.station - 1]

@@ -32,7 +32,15 @@ KINDS = ("bearing", "stiffness", "damping", "mass")
 
 
 def candidates(model, stations=None) -> list[Hypothesis]:
-    """Every bearing and added-element hypothesis of a rotor ``model`` (at ``stations``, default all)."""
+    """Every bearing and added-element hypothesis of a rotor ``model`` (at ``stations``, default all).
+
+    Parameters
+    ----------
+    model : Rotor
+        The engineering model (a rotor).
+    stations : sequence of int, optional
+        Stations to consider (default: all).
+    """
     lay = model.layout
     M, C, K, _ = model.matrices()
     out: list[Hypothesis] = []
@@ -67,7 +75,19 @@ def candidates(model, stations=None) -> list[Hypothesis]:
 
 
 def write(mf, finding, model, note: str) -> None:
-    """Write ``finding`` into the model file ``mf`` (:class:`~mutext.rotor.model_writer.ModelFile`)."""
+    """Write ``finding`` into the model file ``mf`` (:class:`~mutext.rotor.model_writer.ModelFile`).
+
+    Parameters
+    ----------
+    mf : mutext.rotor.model_writer.ModelFile
+        The model file being extended (edited in place).
+    finding : Finding
+        The accepted finding (its hypothesis and fitted size).
+    model : Structure or Rotor
+        The engineering model the finding refers to.
+    note : str
+        Comment written next to the change in the file.
+    """
     h = finding.hypothesis
     v = float(finding.value)
     if h.kind == "bearing":

@@ -33,7 +33,13 @@ KINDS = ("damping_scale", "frequency_scale")
 
 
 def candidates(model) -> list[Hypothesis]:
-    """The structure-wide hypotheses (one each)."""
+    """The structure-wide hypotheses (one each).
+
+    Parameters
+    ----------
+    model : Structure or Rotor
+        The engineering model.
+    """
     return [Hypothesis("damping_scale", None, "damping", "all damping of the structure scaled by (1 + a)", "1",
                        False, -0.9, 10.0, 0.2, glob="damping_scale"),
             Hypothesis("frequency_scale", None, "frequency axis",
@@ -45,7 +51,19 @@ def responses(rec, data, hyps: list, thetas: list) -> list:
     """Per channel response with every hypothesis of ``hyps`` at its size (any family), by full solves.
 
     Channels on the same frequencies (and, with a sensor's mass, the same output) share one dynamic
-    stiffness: one factorisation per frequency, their input vectors solved together."""
+    stiffness: one factorisation per frequency, their input vectors solved together.
+
+    Parameters
+    ----------
+    rec : receptance
+        The engineering model's matrices and frequencies (``M``, ``K``, ``D``, ``omega``).
+    data : data set
+        The channels and their frequency indices (``chans``, ``idx``).
+    hyps : list of Hypothesis
+        The effects, of any family.
+    thetas : list
+        Their sizes.
+    """
     eps = sum(t for h, t in zip(hyps, thetas) if h.glob == "frequency_scale")
     a = sum(t for h, t in zip(hyps, thetas) if h.glob == "damping_scale")
     from .channel import factor            # the measurement chain multiplies afterwards
@@ -82,7 +100,17 @@ def responses(rec, data, hyps: list, thetas: list) -> list:
 
 
 def model_text(text: str, finding, note: str) -> str:
-    """The model file with the finding written in (damping scaled; a frequency scale only noted)."""
+    """The model file with the finding written in (damping scaled; a frequency scale only noted).
+
+    Parameters
+    ----------
+    text : str
+        The model file's text.
+    finding : Finding
+        A whole-structure finding (damping or frequency scale).
+    note : str
+        Comment written next to the change.
+    """
     if finding.kind == "frequency_scale":
         return "# (the analyser's frequency axis: the model itself is unchanged)\n" + text
     mf = ModelFile(text)
