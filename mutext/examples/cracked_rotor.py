@@ -37,6 +37,17 @@ def cracked_rotor(depth_ratio: float = RIG_CRACK_DEPTH_RATIO, *, breathing: str 
     """The healthy rotor with a crack element (default: the rig's, breathing by the Mayes law).
 
     ``breathing=None`` gives an open crack facing ``orientation`` (time-invariant).
+
+    Parameters
+    ----------
+    depth_ratio : float, optional
+        Crack depth over shaft diameter, a/D.
+    breathing : str or None, optional
+        Breathing law (``"mayes"``, ``"gasch"``, ``"gaping"``); None: an open crack at a fixed angle.
+    station : int, optional
+        Station where the cracked shaft element starts (1-based, the thesis's numbering).
+    orientation : float, optional
+        Angle [rad] of the open crack's normal from x (``breathing=None`` only).
     """
     extra = f"\n[[crack]]\nstation = {int(station)}\ndepth_ratio = {float(depth_ratio)!r}\n" \
             f"orientation = {float(orientation)!r}\n"

@@ -22,6 +22,21 @@ __all__ = ["RandomPlant", "random_plant", "random_plants"]
 
 @dataclass
 class RandomPlant:
+    """A reproducible random H-infinity problem (:func:`random_plant`).
+
+    Attributes
+    ----------
+    P : control.StateSpace
+        The generalized plant.
+    nmeas, ncon : int
+        Numbers of measurements and controls (the last outputs and inputs of ``P``).
+    seed : int
+        Seed it was drawn with.
+    open_loop_stable : bool
+        Whether ``A`` is stable.
+    description : str
+        Sizes and properties in words.
+    """
     P: ct.StateSpace
     nmeas: int
     ncon: int
@@ -31,7 +46,22 @@ class RandomPlant:
 
 
 def random_plant(seed: int, n: int | None = None) -> RandomPlant:
-    """One reproducible random plant (order 2-12 unless ``n`` is given)."""
+    """One reproducible random plant (order 2-12 unless ``n`` is given).
+
+    Parameters
+    ----------
+    seed : int
+        Seed of the random generator.
+    n : int, optional
+        Number of states (default: drawn from 2-12).
+
+    Examples
+    --------
+    >>> from mutext.examples.random_plants import random_plant
+    >>> a, b = random_plant(7), random_plant(7)
+    >>> bool((a.P.A == b.P.A).all()), random_plant(7, n=3).P.nstates
+    (True, 3)
+    """
     rng = np.random.default_rng(seed)
     n = int(rng.integers(2, 13)) if n is None else int(n)
     nu = int(rng.integers(1, 3))
@@ -71,5 +101,13 @@ def random_plant(seed: int, n: int | None = None) -> RandomPlant:
 
 
 def random_plants(count: int = 100, first_seed: int = 0):
-    """``count`` plants with seeds ``first_seed, first_seed + 1, ...``."""
+    """``count`` plants with seeds ``first_seed, first_seed + 1, ...``.
+
+    Parameters
+    ----------
+    count : int, optional
+        Number of plants.
+    first_seed : int, optional
+        Seed of the first.
+    """
     return [random_plant(s) for s in range(first_seed, first_seed + count)]

@@ -59,7 +59,13 @@ class ThreeMass:
     c3: float
 
     def with_(self, **kw) -> "ThreeMass":
-        """A copy with some fields changed."""
+        """A copy with some fields changed.
+
+        Parameters
+        ----------
+        **kw
+            New values of fields (``m1``, ``k2``, ``c3``, ...).
+        """
         return replace(self, **kw)
 
 
@@ -80,7 +86,20 @@ AIR_DAMPER = 8.8078
 
 
 def matrices(p: ThreeMass = TABLE_3_1):
-    """Mass, damping and stiffness matrices ``(M, C, K)`` of the chain (SI)."""
+    """Mass, damping and stiffness matrices ``(M, C, K)`` of the chain (SI).
+
+    Parameters
+    ----------
+    p : ThreeMass, optional
+        The rig (default: Table 3.1).
+
+    Examples
+    --------
+    >>> from mutext.examples.three_mass import TABLE_3_1, matrices
+    >>> M, C, K = matrices(TABLE_3_1)
+    >>> M.shape, bool((K == K.T).all())
+    ((3, 3), True)
+    """
     for name in ("m1", "m2", "m3", "k1", "k2", "k3", "c1", "c2", "c3"):
         v = getattr(p, name)
         if not np.isfinite(v) or v < 0 or (name.startswith("m") and v == 0):
@@ -96,7 +115,13 @@ def matrices(p: ThreeMass = TABLE_3_1):
 
 def mechanical_model(p: ThreeMass = TABLE_3_1) -> ct.StateSpace:
     """Inputs ``f1`` (N on cart 1, the exciter) and ``f3`` (N on cart 3);
-    outputs ``x1``, ``x3`` (m)."""
+    outputs ``x1``, ``x3`` (m).
+
+    Parameters
+    ----------
+    p : ThreeMass, optional
+        The rig (default: Table 3.1).
+    """
     M, C, K = matrices(p)
     return mck_to_ss(M, C, K, inputs={"f1": 0, "f3": 2}, outputs={"x1": 0, "x3": 2},
                      dof_names=["x1", "x2", "x3"])
@@ -110,6 +135,23 @@ class Trial:
     uncertainty of the true system's changed parameters; ``Wz`` (m) and
     ``mu`` the thesis's final values; ``Du`` the known difference as the
     added mechanical impedance ``dm s^2 + dc s + dk`` on cart 3.
+
+    Attributes
+    ----------
+    name : str
+        Name of the trial.
+    engineering : ThreeMass
+        The engineering model's rig.
+    true : ThreeMass
+        The true rig.
+    uncertainty : float
+        Relative uncertainty of the true system's changed parameters.
+    Wz : float
+        The thesis's final error bound [m].
+    mu : float
+        The thesis's final mu.
+    Du : dict
+        The known difference: ``{"dm": kg, "dc": N s/m, "dk": N/m}`` on cart 3.
     """
     name: str
     engineering: ThreeMass

@@ -36,7 +36,25 @@ THESIS_GAMMA = 0.9671
 
 @dataclass(frozen=True)
 class TwoMass:
-    """Parameters of the two-mass problem (SI units)."""
+    """Parameters of the two-mass problem (SI units).
+
+    Attributes
+    ----------
+    m1, m2 : float
+        Upper mass (disturbed, performance output) and lower mass (actuated, measured) [kg].
+    k1, k2 : float
+        Spring m1 to m2 and spring m2 to ground [N/m].
+    f_max : float
+        Largest disturbance force on m1 [N].
+    eta_max : float
+        Largest sensor noise [m].
+    x_max : float
+        Allowed displacement of m1 [m].
+    u_max : float
+        Allowed control force [N].
+    w_x, w_u : float or None
+        Performance weights overriding ``1/x_max`` and ``1/u_max`` (the thesis writes 28.6 and 0.02).
+    """
     m1: float = 1.0        # kg, upper mass (disturbed, performance output)
     m2: float = 2.0        # kg, lower mass (actuated, measured)
     k1: float = 450.0      # N/m, m1 to m2
@@ -50,7 +68,13 @@ class TwoMass:
     w_u: float | None = None
 
     def with_(self, **kw) -> "TwoMass":
-        """A copy with some fields changed."""
+        """A copy with some fields changed.
+
+        Parameters
+        ----------
+        **kw
+            New values of fields (``m1``, ``x_max``, ...).
+        """
         return replace(self, **kw)
 
     @property
@@ -69,7 +93,13 @@ THESIS = TwoMass(w_x=28.6, w_u=0.02)
 
 
 def mechanical_model(p: TwoMass = THESIS) -> ct.StateSpace:
-    """Physical model: inputs ``f_e`` (N on m1) and ``u`` (N on m2); outputs ``x1``, ``x2`` (m)."""
+    """Physical model: inputs ``f_e`` (N on m1) and ``u`` (N on m2); outputs ``x1``, ``x2`` (m).
+
+    Parameters
+    ----------
+    p : TwoMass, optional
+        The parameters (default: the thesis's).
+    """
     for name in ("m1", "m2", "k1", "k2"):
         if not getattr(p, name) > 0:
             raise ModelError(f"two-mass parameter {name} must be positive, got {getattr(p, name)}")
@@ -85,6 +115,18 @@ def plant(p: TwoMass = THESIS) -> ct.StateSpace:
     Inputs ``[f1, f2, u]`` (normalised disturbance, normalised noise, control
     force in N); outputs ``[z1, z2, y]`` (weighted x1, weighted u, measured x2
     in m).  Use with ``nmeas=1, ncon=1``.
+
+    Parameters
+    ----------
+    p : TwoMass, optional
+        The parameters (default: the thesis's).
+
+    Examples
+    --------
+    >>> from mutext.examples.two_mass import plant
+    >>> P = plant()
+    >>> P.ninputs, P.noutputs, P.nstates
+    (3, 3, 4)
     """
     for name in ("f_max", "eta_max", "x_max", "u_max"):
         if not getattr(p, name) > 0:

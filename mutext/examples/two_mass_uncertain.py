@@ -42,7 +42,15 @@ THESIS_ORDER = 18
 
 
 def parameters(p: TwoMass = TwoMass(), rel: float = 0.02) -> list[UncertainParameter]:
-    """The four uncertain parameters, each ``+/- rel`` around the values of ``p``."""
+    """The four uncertain parameters, each ``+/- rel`` around the values of ``p``.
+
+    Parameters
+    ----------
+    p : TwoMass, optional
+        The parameters (default: the thesis's).
+    rel : float, optional
+        Relative half-width of every parameter's interval (0.02 is +-2 %).
+    """
     return [UncertainParameter("m1", p.m1, rel=rel), UncertainParameter("m2", p.m2, rel=rel),
             UncertainParameter("k1", p.k1, rel=rel), UncertainParameter("k2", p.k2, rel=rel)]
 
@@ -54,7 +62,15 @@ def _mck(v):
 
 
 def uncertain_model(p: TwoMass = TwoMass(), rel: float = 0.02) -> UncertainModel:
-    """Mechanical model with inputs ``[w_m1.., f_e, u]`` and outputs ``[z_m1.., x1, x2]``."""
+    """Mechanical model with inputs ``[w_m1.., f_e, u]`` and outputs ``[z_m1.., x1, x2]``.
+
+    Parameters
+    ----------
+    p : TwoMass, optional
+        The parameters (default: the thesis's).
+    rel : float, optional
+        Relative half-width of every parameter's interval (0.02 is +-2 %).
+    """
     return uncertain_mck(_mck, parameters(p, rel), inputs={"f_e": 0, "u": 1},
                          outputs={"x1": 0, "x2": 1}, dof_names=["x1", "x2"])
 
@@ -86,6 +102,16 @@ def plant(x_max: float = 0.035, rel: float = 0.02, p: TwoMass | None = None) -> 
 
     The weights are the exact reciprocals ``1/x_max`` and ``1/u_max`` (the
     thesis prints 28.6 for 1/0.035).
+
+    Parameters
+    ----------
+    x_max : float, optional
+        Allowed displacement of m1 [m] (the performance weight is ``1/x_max``).
+    rel : float, optional
+        Relative half-width of every parameter's interval (0.02 is +-2 %).
+
+    p : TwoMass, optional
+        The other parameters (default: the thesis's).
     """
     p = TwoMass(x_max=x_max) if p is None else p.with_(x_max=x_max)
     U = uncertain_model(p, rel)
@@ -100,7 +126,20 @@ def structure() -> BlockStructure:
 
 def plant_at(delta, x_max: float = 0.035, rel: float = 0.02, p: TwoMass | None = None) -> ct.StateSpace:
     """The H-infinity plant (inputs ``[f1, f2, u]``, outputs ``[z1, z2, y]``) for normalised
-    parameter perturbations ``delta`` (four numbers in [-1, 1]), rebuilt from M and K."""
+    parameter perturbations ``delta`` (four numbers in [-1, 1]), rebuilt from M and K.
+
+    Parameters
+    ----------
+    delta : (4,) array_like
+        Normalised perturbations of m1, m2, k1, k2.
+    x_max : float, optional
+        Allowed displacement of m1 [m] (the performance weight is ``1/x_max``).
+    rel : float, optional
+        Relative half-width of every parameter's interval (0.02 is +-2 %).
+
+    p : TwoMass, optional
+        The other parameters (default: the thesis's).
+    """
     p = TwoMass(x_max=x_max) if p is None else p.with_(x_max=x_max)
     U = uncertain_model(p, rel)
     G = U.at(U.values(delta))
@@ -138,6 +177,11 @@ def refined_controller(x_max: float = 0.041) -> ct.StateSpace:
     bound is flat from DC to about 1 rad/s, where the static gain :math:`K(0)` alone
     sets it, and touches the same level in narrow peaks up to 400 rad/s (the book's
     mu chapter).
+
+    Parameters
+    ----------
+    x_max : {0.041, 0.035}, optional
+        The performance level [m] the controller was refined at.
 
     Examples
     --------

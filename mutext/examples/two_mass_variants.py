@@ -106,6 +106,11 @@ def variant_plant(v: VariantSpec = VariantSpec()):
     With the default :class:`VariantSpec` this is the plant of thesis
     eqs. 2.22-2.24 (identical to :func:`mutext.examples.two_mass.plant` with
     :data:`~mutext.examples.two_mass.THESIS`).
+
+    Parameters
+    ----------
+    v : VariantSpec, optional
+        The reading of the problem (default: the thesis's).
     """
     M = np.diag([v.m1, v.m2])
     g = np.zeros((2, 2))
@@ -134,6 +139,13 @@ def slycot_gamma(P, nmeas: int = 1, ncon: int = 1) -> tuple[float, float]:
     The two can differ: on some lightly damped variants slycot reports a
     level that its own controller does not reach, so only the second number
     is a verified upper bound on the optimum.  Both are ``nan`` on failure.
+
+    Parameters
+    ----------
+    P : control.StateSpace
+        The generalized plant.
+    nmeas, ncon : int, optional
+        Numbers of measurements and controls.
     """
     import control as ct
     try:
@@ -182,7 +194,27 @@ FITS: list[tuple[str, str, tuple[float, float]]] = [
 
 @dataclass
 class VariantResult:
-    """Level of one variant."""
+    """Level of one variant.
+
+    Attributes
+    ----------
+    label : str
+        Name of the variant.
+    change : str
+        What differs from the thesis's reading.
+    gamma : float
+        Our LMI level.
+    gamma_slycot : float
+        The level slycot reports.
+    closed_loop_slycot : float
+        The norm slycot's controller achieves.
+    closed_loop_hinf : float
+        The norm our controller achieves.
+    matches : bool
+        ``gamma`` rounds to the target.
+    spec : VariantSpec
+        The variant.
+    """
     label: str
     change: str
     #: gamma: our LMI level; gamma_slycot: the level slycot reports;
@@ -231,6 +263,17 @@ def fit_parameter(name: str, bracket: tuple[float, float], target: float = THESI
     finder (slycot's reported level is not used: it is unreliable for some
     damped variants, see :func:`slycot_gamma`).
 
+    Parameters
+    ----------
+    name : str
+        A continuous field of :class:`VariantSpec` (e.g. ``"k2"``).
+    bracket : (float, float)
+        Interval searched.
+    target : float, optional
+        The level to reach.
+    base : VariantSpec, optional
+        The other fields.
+
     Returns
     -------
     (value, gamma) : tuple of float
@@ -256,7 +299,13 @@ def fit_parameter(name: str, bracket: tuple[float, float], target: float = THESI
 
 
 def table(results: list[VariantResult]) -> str:
-    """Plain-text table of :func:`investigate` results."""
+    """Plain-text table of :func:`investigate` results.
+
+    Parameters
+    ----------
+    results : list of VariantResult
+        The results of :func:`investigate`.
+    """
     lines = [f"{'variant':24s} {'gamma (LMI)':>12s} {'our K achieves':>15s} {'slycot reports':>15s} "
              f"{'slycot K achieves':>18s}  match"]
     for r in results:

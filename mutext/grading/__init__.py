@@ -38,7 +38,13 @@ def __getattr__(name):
 
 
 def cli_grade(argv) -> int:
-    """``mutext grade ...``: the instructor's grader if it is installed, else a pointer to ``mutext check``."""
+    """``mutext grade ...``: the instructor's grader if it is installed, else a pointer to ``mutext check``.
+
+    Parameters
+    ----------
+    argv : list of str
+        The command line after ``grade``.
+    """
     import sys
     try:
         from mutext_grader import cli_grade as grader_cli

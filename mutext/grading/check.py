@@ -55,7 +55,15 @@ _PRIORITY = ("missing", "not_implemented", "raises", "wrong_kind")
 
 class CheckError(MutextError):
     """The check was used wrongly (``usage``: unknown exercise, missing file, not a ``.py`` file, a bad time
-    limit) or the file could not be run in a confined process at all."""
+    limit) or the file could not be run in a confined process at all.
+
+    Parameters
+    ----------
+    message : str
+        What went wrong.
+    usage : bool, optional
+        A wrong use (exit status 2), not a failure to run the file.
+    """
 
     def __init__(self, message, usage=True):
         super().__init__(message)
@@ -64,7 +72,27 @@ class CheckError(MutextError):
 
 @dataclass
 class FunctionCheck:
-    """What happened to one function on its sample calls."""
+    """What happened to one function on its sample calls.
+
+    Attributes
+    ----------
+    id : str
+        Question id.
+    function : str
+        Name of the function.
+    title : str
+        The question's title.
+    expected : str
+        The expected return, in words.
+    status : str
+        A key of :data:`STATUS_TEXT`.
+    calls : int
+        Sample calls made.
+    good : int
+        Calls that ran and returned the right kind of value.
+    messages : list of str
+        What went wrong, per call.
+    """
     id: str
     function: str
     title: str
@@ -81,6 +109,36 @@ class FunctionCheck:
 
 @dataclass
 class CheckReport:
+    """What ``mutext check`` found in one submission.
+
+    Attributes
+    ----------
+    exercise : str
+        Name of the exercise.
+    title : str
+        Its title.
+    file : str
+        The submission checked.
+    functions : list of FunctionCheck
+        One entry per graded function.
+    inputs : str
+        Which sample inputs were used, in words.
+    seed : int or None
+        Seed of the sample inputs.
+    imported : bool
+        Whether the file imported.
+    import_error : str
+        The error when it did not.
+    notes : list of str
+        Further remarks.
+    isolation : str
+        How the child was confined: ``"uid"``, ``"landlock"`` or ``"none"``.
+    isolation_details : list of str
+        What the confinement did and did not achieve.
+
+    seconds : float
+        Wall time of the check.
+    """
     exercise: str
     title: str
     file: str

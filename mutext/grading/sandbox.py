@@ -140,6 +140,17 @@ class Job:
     values; a state-space argument is ``{"__ss__": [A, B, C, D]}``.
     ``kind`` is ``"ss"`` (return a state-space model), ``"float"`` or
     ``"array"`` (an array of real numbers, e.g. a matrix or a tuple ``(K, M)``).
+
+    Attributes
+    ----------
+    id : str
+        Question id.
+    function : str
+        Name of the function to call.
+    kind : str
+        ``"ss"``, ``"float"`` or ``"array"``.
+    calls : list of dict
+        The calls, ``{"args": [...], "kwargs": {...}}``.
     """
     id: str
     function: str
@@ -153,6 +164,21 @@ class PhaseOutcome:
 
     ``status`` is ``"ok"``, ``"error"`` (import failed), ``"timeout"``,
     ``"crashed"`` (the child died) or ``"not_run"``.
+
+    Attributes
+    ----------
+    status : str
+        ``"ok"``, ``"error"``, ``"timeout"``, ``"crashed"`` or ``"not_run"``.
+    calls : list
+        Result of each call made.
+    error : str
+        The error message (import failed, a crash).
+    violations : list of str
+        Forbidden operations the child attempted.
+    seconds : float
+        Wall time of the phase.
+    last_call : int or None
+        Index of the call running when the phase was cut short.
     """
     status: str
     calls: list = field(default_factory=list)
@@ -164,6 +190,23 @@ class PhaseOutcome:
 
 @dataclass
 class SandboxResult:
+    """What happened to a submission run by :func:`run_submission`.
+
+    Attributes
+    ----------
+    import_ : PhaseOutcome
+        The import of the submission.
+    questions : dict
+        Question id -> :class:`PhaseOutcome`.
+    children : int
+        Number of child processes started (one more per restart).
+    stderr_tail : str
+        The end of the children's standard error.
+    isolation : str
+        How the child was confined: ``"uid"``, ``"landlock"`` or ``"none"``.
+    isolation_details : list of str
+        What the confinement did and did not achieve.
+    """
     import_: PhaseOutcome
     questions: dict
     children: int = 0

@@ -38,7 +38,27 @@ __all__ = ["QuestionSpec", "ExerciseSpec", "EXERCISES", "get_exercise", "find_ex
 
 @dataclass(frozen=True)
 class QuestionSpec:
-    """One graded function of an exercise."""
+    """One graded function of an exercise.
+
+    Attributes
+    ----------
+    id : str
+        Question id (e.g. ``"q1"``).
+    function : str
+        Name of the function students write.
+    title : str
+        The question in words.
+    points : float
+        Points it carries.
+    kind : str
+        ``"ss"``, ``"float"`` or ``"array"``: what the child sends back.
+    returns : str
+        The expected return, in words (shape rules).
+    sample_calls : callable
+        ``sample_calls(rng)`` -> list of ``(args, kwargs)``, JSON-ready.
+    shape_problem : callable
+        ``shape_problem(value, args, kwargs)`` -> None, or what was expected.
+    """
     id: str
     function: str
     title: str
@@ -51,6 +71,23 @@ class QuestionSpec:
 
 @dataclass(frozen=True)
 class ExerciseSpec:
+    """One exercise: its file, its graded functions and what the submission may not import.
+
+    Attributes
+    ----------
+    name : str
+        Name of the exercise (e.g. ``"ex01_star"``).
+    title : str
+        Its title.
+    description : str
+        What it asks, in words.
+    stub : str
+        The file students fill in, relative to the repository.
+    blocked_modules : tuple of str
+        Library modules the submission may not import (they compute the answers).
+    questions : tuple of QuestionSpec
+        The graded functions.
+    """
     name: str
     title: str
     description: str
@@ -63,11 +100,24 @@ class ExerciseSpec:
         return float(sum(q.points for q in self.questions))
 
     def question(self, qid: str) -> QuestionSpec:
+        """The question with id ``qid``.
+
+        Parameters
+        ----------
+        qid : str
+            Question id.
+        """
         return next(q for q in self.questions if q.id == qid)
 
 
 class UnknownExercise(LookupError):
-    """No exercise of that name (or several start with it)."""
+    """No exercise of that name (or several start with it).
+
+    Parameters
+    ----------
+    name : str
+        The name asked for.
+    """
 
     def __init__(self, name):
         self.name = name
@@ -726,13 +776,25 @@ EXERCISES = {ex.name: ex for ex in (EX01, EX02, EX03, EX04, EX05, EX06, EX07, EX
 
 
 def find_exercise(name: str) -> str | None:
-    """The full name of the exercise ``name`` (or the only one starting with it, e.g. ``ex01``), or None."""
+    """The full name of the exercise ``name`` (or the only one starting with it, e.g. ``ex01``), or None.
+
+    Parameters
+    ----------
+    name : str
+        Full name or a unique prefix.
+    """
     found = [n for n in EXERCISES if n == name] or [n for n in EXERCISES if name and n.startswith(name)]
     return found[0] if len(found) == 1 else None
 
 
 def get_exercise(name: str) -> ExerciseSpec:
-    """The exercise called ``name`` (a unique prefix such as ``ex01`` works); :class:`UnknownExercise` else."""
+    """The exercise called ``name`` (a unique prefix such as ``ex01`` works); :class:`UnknownExercise` else.
+
+    Parameters
+    ----------
+    name : str
+        Full name or a unique prefix.
+    """
     full = find_exercise(name)
     if full is None:
         raise UnknownExercise(name)
