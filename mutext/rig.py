@@ -750,6 +750,8 @@ def measure_rotor(model, in_port: str, out_port: str, freq_hz=None, *, noise=Non
         Default :func:`sweep_frequencies` (20-225 Hz, 0.5 Hz).
     noise, rng
         As in :func:`measure`.
+    metadata : mapping, optional
+        Extra metadata stored in every FRF recorded.
     harmonics, cutoff_hz, revolutions, settle_s
         Harmonic-balance truncation, reduction cutoff [Hz] and the analyzer's
         correlation length and settling time (thesis: 40 revolutions, 700 ms).
@@ -893,7 +895,21 @@ def _measure_planar(model, in_port, out_port, f, speed, speed_hz, noise, rng, ha
 
 def with_noise(frf: FRF, noise=None, *, rng=None) -> FRF:
     """A copy of ``frf`` measured with ``noise`` (as in :func:`measure`: same generator, same
-    metadata entries); stations, quantities, directions, names and speed are kept."""
+    metadata entries); stations, quantities, directions, names and speed are kept.
+
+    Parameters
+    ----------
+    frf : FRF
+        The exact response.
+    noise : None, float, (relative, floor) or Noise
+        As in :func:`measure`.
+    rng : numpy.random.Generator or int, optional
+        Random generator or seed.
+
+    Returns
+    -------
+    FRF
+    """
     out = measure(lambda w: frf.response, 0, 0, frf.freq_hz, noise=noise, rng=rng,
                   input_station=frf.input_station, output_station=frf.output_station,
                   input_quantity=frf.input_quantity, output_quantity=frf.output_quantity,

@@ -208,7 +208,13 @@ class DirectionalFRF:
                          [(pp - bb + pb - bp) / 2j, (pp + bb - pb - bp) / 2]])
 
     def peaks(self, **kw) -> list:
-        """:func:`whirl_peaks` of these dFRFs."""
+        """:func:`whirl_peaks` of these dFRFs.
+
+        Parameters
+        ----------
+        **kw
+            Options of :func:`whirl_peaks` (``rel_height``).
+        """
         return whirl_peaks(self, **kw)
 
 

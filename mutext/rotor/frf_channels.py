@@ -144,7 +144,20 @@ def select_points(freq_hz, response, max_points: int) -> np.ndarray:
     Half of them log-spaced over the band; the rest in windows around the
     largest local maxima (resonances) and the deepest local minima
     (anti-resonances) of :math:`|H|`, where the response changes fastest.
-    Returns sorted unique indices.
+
+    Parameters
+    ----------
+    freq_hz : array_like (n,)
+        Frequencies [Hz], increasing.
+    response : array_like (n,)
+        The FRF at them (complex).
+    max_points : int or None
+        About how many to keep (at least 4); None keeps all.
+
+    Returns
+    -------
+    ndarray of int
+        Sorted unique indices into ``freq_hz``.
     """
     f = np.asarray(freq_hz, float)
     n = f.size
