@@ -56,6 +56,13 @@ _UNITS_HELP = ("read a units label of the files as another, once per label (e.g.
 
 
 def add_arguments(p):
+    """Declare the subcommand's options on ``p``.
+
+    Parameters
+    ----------
+    p : argparse.ArgumentParser
+        The subcommand's parser.
+    """
     sub = p.add_subparsers(dest="action", required=True)
     c = sub.add_parser(
         "convert", help="convert FRF files between mutext's CSV (.csv) and Universal File data set 58 (.uff/.unv)",
@@ -160,7 +167,13 @@ def _units(items):
 def reading_notes(frfs) -> list[str]:
     """What the readers noted about ``frfs`` (``metadata["notes"]``, a list of str) and the conversions they
     made (``metadata["conversion"]``), one line per note and file: the data sets or channels a note is
-    about are named together."""
+    about are named together.
+
+    Parameters
+    ----------
+    frfs : iterable of mutext.response.FRF
+        The FRFs as read.
+    """
     seen: dict[tuple[str, str], list[str]] = {}
     for h in frfs:
         md = h.metadata
@@ -186,6 +199,26 @@ def convert(inputs, output, *, ordinate=None, binary=False, unit=None, mapping=N
     user should know (what the readers did: :func:`reading_notes`; precision,
     header entries UFF cannot hold).  ``units``: labels to read differently
     (:func:`mutext.uff.read_uff58`).
+
+    Parameters
+    ----------
+    inputs : sequence of str or path-like
+        FRF files to read (.csv, .uff, .unv).
+    output : str or path-like
+        File to write; its extension sets the format.
+    ordinate : {"displacement", "velocity", "acceleration"}, optional
+        Ordinate of a Universal File written (default displacement per force).
+    binary : bool, optional
+        Write a Universal File as binary data set 58b (double precision).
+    unit : {"m", "mm", "um", "in"}, optional
+        Output unit of a CSV file (per N or A).
+    mapping : dict, optional
+        Universal File node -> model station.
+    units : dict, optional
+        Units labels to read differently (label -> unit, :func:`mutext.uff.read_uff58`).
+
+    notes : list, optional
+        Receives the notes, one str each.
     """
     from ..errors import ModelError, UsageError
     from ..rig import FRFFileError, read_frfs, write_frf
@@ -340,6 +373,19 @@ def _channel_names(frfs) -> list[str]:
 def resonance_table(paths, *, band=None, n_boot: int = 20, mapping=None, units=None) -> dict:
     """Read the FRF files ``paths`` and find their resonances (see the module docstring).
 
+    Parameters
+    ----------
+    paths : sequence of str or path-like
+        FRF files.
+    band : (float, float), optional
+        Report resonances in this band [Hz] only.
+    n_boot : int, optional
+        Bootstrap refits for the uncertainties.
+    mapping : dict, optional
+        Universal File node -> model station.
+    units : dict, optional
+        Units labels to read differently (label -> unit, :func:`mutext.uff.read_uff58`).
+
     Returns
     -------
     dict
@@ -411,7 +457,13 @@ def _pm(value, std, scale=1.0) -> str:
 def format_table(res) -> str:
     """The text table of :func:`resonance_table`'s result: the channels, then one row per mode (natural
     frequency and damping ratio, each +/- one standard uncertainty, and the channels that see it), then
-    the poles that were not reproducible."""
+    the poles that were not reproducible.
+
+    Parameters
+    ----------
+    res : dict
+        The result of :func:`resonance_table`.
+    """
     chans = res["channels"]
     wn = max([len("channel")] + [len(c["name"]) for c in chans])
     out = [f"Resonances of {len(chans)} channel{'s' if len(chans) != 1 else ''} (model-free: a rational fit per "
@@ -460,6 +512,18 @@ def _run_resonances(args) -> int:
 
 
 def run(args) -> int:
+    """Run the subcommand with the parsed ``args``.
+
+    Parameters
+    ----------
+    args : argparse.Namespace
+        The parsed command line.
+
+    Returns
+    -------
+    int
+        The exit status.
+    """
     if args.action == "resonances":
         return _run_resonances(args)
     notes = []

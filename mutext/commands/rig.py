@@ -9,6 +9,13 @@ MAX_COUNT = 10_000
 
 
 def add_arguments(p):
+    """Declare the subcommand's options on ``p``.
+
+    Parameters
+    ----------
+    p : argparse.ArgumentParser
+        The subcommand's parser.
+    """
     sub = p.add_subparsers(dest="action", required=True)
     h = sub.add_parser("hide", help="write a data set with a hidden effect (model, measured and validation "
                                     "FRFs, answer key apart)")
@@ -26,6 +33,18 @@ def add_arguments(p):
 
 
 def run(args) -> int:
+    """Run the subcommand with the parsed ``args``.
+
+    Parameters
+    ----------
+    args : argparse.Namespace
+        The parsed command line.
+
+    Returns
+    -------
+    int
+        The exit status.
+    """
     import os
     from ..errors import ModelError, UsageError
     from ..hide import hidden_effect_data

@@ -13,6 +13,13 @@ import math
 
 
 def add_arguments(p):
+    """Declare the subcommand's options on ``p``.
+
+    Parameters
+    ----------
+    p : argparse.ArgumentParser
+        The subcommand's parser.
+    """
     sub = p.add_subparsers(dest="action", required=True)
     c = sub.add_parser("campbell", help="Campbell diagram: whirl frequencies, log decrement and critical speeds",
                        description="The Campbell diagram of a rotor model file: whirl frequencies of the lowest "
@@ -30,7 +37,19 @@ def add_arguments(p):
 
 
 def parse_speeds(text: str):
-    """``"0:3000:31"`` or ``"0,500,1000"`` (rpm) -> list of float, or UsageError naming the option."""
+    """``"0:3000:31"`` or ``"0,500,1000"`` (rpm) -> list of float, or UsageError naming the option.
+
+    Parameters
+    ----------
+    text : str
+        ``START:STOP:COUNT`` or a comma-separated list, in rpm.
+
+    Examples
+    --------
+    >>> from mutext.commands.rotor import parse_speeds
+    >>> parse_speeds("0:3000:4"), parse_speeds("600, 1200")
+    ([0.0, 1000.0, 2000.0, 3000.0], [600.0, 1200.0])
+    """
     from ..errors import UsageError
     t = str(text).strip()
     try:
@@ -63,6 +82,18 @@ def _orders(text: str):
 
 
 def run(args) -> int:
+    """Run the subcommand with the parsed ``args``.
+
+    Parameters
+    ----------
+    args : argparse.Namespace
+        The parsed command line.
+
+    Returns
+    -------
+    int
+        The exit status.
+    """
     import os
 
     from ..errors import ModelError, UsageError

@@ -31,6 +31,13 @@ from ..examples import cracked_rotor as ex
 
 
 def add_arguments(p):
+    """Declare the subcommand's options on ``p``.
+
+    Parameters
+    ----------
+    p : argparse.ArgumentParser
+        The subcommand's parser.
+    """
     p.add_argument("--json", action="store_true", help="print one JSON object instead of a report")
     p.add_argument("--plots", metavar="DIR", help="save the figures (PNG) in DIR")
     p.add_argument("--depth", type=float, default=0.4, help="crack depth over diameter (default 0.4)")
@@ -72,7 +79,27 @@ def solve(depth: float = 0.4, law: str = "mayes", noise: float = 0.001, seed: in
     """Everything the demo reports, as a dict (SI; frequencies in Hz).
 
     ``out`` gets the log, ``progress(stage, fraction)`` the W_z search's progress
-    (:func:`mutext.mbi.identify`)."""
+    (:func:`mutext.mbi.identify`).
+
+    Parameters
+    ----------
+    depth : float, optional
+        Crack depth over shaft diameter, a/D.
+    law : {"mayes", "gasch", "open"}, optional
+        Breathing law of the rig's crack.
+    noise : float, optional
+        Relative noise of the measured sweep.
+    seed : int, optional
+        Seed of the noise.
+    cutoff_hz : float, optional
+        Modal truncation of the engineering model [Hz].
+    thesis_tables : bool, optional
+        Also identify the thesis's cracked station table (:func:`thesis_tables_path`).
+    out : file-like, optional
+        Where the log is written.
+    progress : callable, optional
+        ``progress(stage, fraction)`` for the long steps.
+    """
     from ..diagnose import sideband_evidence
     from ..errors import ModelError
     from ..lti import freqresp
@@ -165,7 +192,17 @@ def solve(depth: float = 0.4, law: str = "mayes", noise: float = 0.001, seed: in
 def thesis_tables_path(result, *, out=None, progress=None) -> dict:
     """The thesis's own data path: its cracked station table (density and disk mass tuned by hand,
     no crack element) as the true system, against the same engineering model as ``result``
-    (a dict of :func:`solve`), with the same noise."""
+    (a dict of :func:`solve`), with the same noise.
+
+    Parameters
+    ----------
+    result : dict
+        The result of :func:`solve`.
+    out : file-like, optional
+        Where the log is written.
+    progress : callable, optional
+        ``progress(stage, fraction)`` for the long steps.
+    """
     from ..lti import freqresp
     from ..rig import measure
     f = result["freqs_hz"]
@@ -191,6 +228,18 @@ JSON_KEYS = ("mu", "mu_lower", "Wz", "K_order", "equivalent_stiffness_loss", "id
 
 
 def run(args) -> int:
+    """Run the subcommand with the parsed ``args``.
+
+    Parameters
+    ----------
+    args : argparse.Namespace
+        The parsed command line.
+
+    Returns
+    -------
+    int
+        The exit status.
+    """
     if getattr(args, "plots", None) is not None:
         from .._files import output_directory
         output_directory(args.plots, "--plots")     # checked before the work, not after it

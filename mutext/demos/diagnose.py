@@ -18,6 +18,13 @@ from ..hide import EXAMPLES, hidden_effect_data
 
 
 def add_arguments(p):
+    """Declare the subcommand's options on ``p``.
+
+    Parameters
+    ----------
+    p : argparse.ArgumentParser
+        The subcommand's parser.
+    """
     p.add_argument("--example", default="four_story", choices=list(EXAMPLES),
                    help="shipped model hiding the effect (default four_story; rotor takes about a minute)")
     p.add_argument("--seed", type=int, default=5, help="seed of the hidden effect and the noise (default 5)")
@@ -32,6 +39,18 @@ def add_arguments(p):
 
 
 def run(args) -> int:
+    """Run the subcommand with the parsed ``args``.
+
+    Parameters
+    ----------
+    args : argparse.Namespace
+        The parsed command line.
+
+    Returns
+    -------
+    int
+        The exit status.
+    """
     if getattr(args, "out", None) is not None:
         from .._files import output_directory
         output_directory(args.out, "--out")     # checked before the work, not after it

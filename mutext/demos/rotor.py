@@ -32,6 +32,13 @@ UNBALANCE = {"station": 15, "kg_m": 1e-5, "probe": 13}
 
 
 def add_arguments(p):
+    """Declare the subcommand's options on ``p``.
+
+    Parameters
+    ----------
+    p : argparse.ArgumentParser
+        The subcommand's parser.
+    """
     p.add_argument("--json", action="store_true", help="print one JSON object instead of a report")
     p.add_argument("--plots", metavar="DIR", help="save the FRF and Campbell diagram (PNG) in DIR")
     p.add_argument("--model", metavar="TOML", help="model file (default: mutext/data/rotor.toml)")
@@ -40,7 +47,19 @@ def add_arguments(p):
 
 
 def solve(model_path=None, *, n_modes=6, points=400, band=(20.0, 225.0)):
-    """Everything the demo reports, as a dict (SI; frequencies in Hz)."""
+    """Everything the demo reports, as a dict (SI; frequencies in Hz).
+
+    Parameters
+    ----------
+    model_path : str or path-like, optional
+        Model file (default: ``mutext/data/rotor.toml``).
+    n_modes : int, optional
+        Number of natural frequencies reported.
+    points : int, optional
+        FRF frequencies in ``band``.
+    band : (float, float), optional
+        Frequency band [Hz] of the FRF.
+    """
     from ..errors import ModelError
     from ..response import local_extrema
     from ..rotor import data_path, load_model
@@ -96,6 +115,18 @@ def solve(model_path=None, *, n_modes=6, points=400, band=(20.0, 225.0)):
 
 
 def run(args) -> int:
+    """Run the subcommand with the parsed ``args``.
+
+    Parameters
+    ----------
+    args : argparse.Namespace
+        The parsed command line.
+
+    Returns
+    -------
+    int
+        The exit status.
+    """
     if getattr(args, "plots", None) is not None:
         from .._files import output_directory
         output_directory(args.plots, "--plots")     # checked before the work, not after it
@@ -143,7 +174,15 @@ def run(args) -> int:
 
 
 def save_plots(out, directory):
-    """FRF (magnitude and phase) of both rotors and the healthy rotor's Campbell diagram, as PNG files."""
+    """FRF (magnitude and phase) of both rotors and the healthy rotor's Campbell diagram, as PNG files.
+
+    Parameters
+    ----------
+    out : dict
+        The result of :func:`solve`.
+    directory : str or path-like
+        Folder for the PNG files (created if missing).
+    """
     import matplotlib
     matplotlib.use("Agg", force=False)
     import matplotlib.pyplot as plt

@@ -18,6 +18,13 @@ from ..mbi import identify, impedance_response, relative_error
 
 
 def add_arguments(p):
+    """Declare the subcommand's options on ``p``.
+
+    Parameters
+    ----------
+    p : argparse.ArgumentParser
+        The subcommand's parser.
+    """
     p.add_argument("--trial", default="1a", choices=list(three_mass.TRIALS),
                    help="thesis trial (1a, 1b: spring; 2: mass; 3: damper; 4, 5: all three, 5 with 10 %% uncertainty)")
     p.add_argument("--json", action="store_true", help="print one JSON object instead of a report")
@@ -44,7 +51,19 @@ def add_arguments(p):
 
 def measured_sweep(trial: str, noise: float, path, rng=0):
     """The true rig of ``trial`` swept on the virtual rig (0.2-10 Hz in 0.02 Hz steps, force
-    at cart 1, displacement of cart 1), written to the FRF file ``path`` (in mm) and read back."""
+    at cart 1, displacement of cart 1), written to the FRF file ``path`` (in mm) and read back.
+
+    Parameters
+    ----------
+    trial : str
+        A key of :data:`mutext.examples.three_mass.TRIALS`.
+    noise : float
+        Relative noise of the sweep.
+    path : str or path-like
+        FRF file written.
+    rng : numpy.random.Generator or int, optional
+        Random generator or seed of the noise.
+    """
     from ..rig import measure, read_frf, sweep_frequencies, write_frf
     T = three_mass.mechanical_model(three_mass.TRIALS[trial].true)
     frf = measure(T, "f1", "x1", sweep_frequencies(0.2, 9.98, 0.02), noise=noise, rng=rng, input_station=1,
@@ -62,7 +81,27 @@ def solve(trial: str = "1a", out=sys.stderr, measured=None, progress=None, real:
     says otherwise); ``dk_options``: added to the D-K options of each try (:func:`mutext.mbi.identify`).
 
     ``measured``: a :class:`mutext.rig.FRF` (f1 -> x1) that replaces the trial's
-    uncertain true model (the W_z search then starts from its own guess)."""
+    uncertain true model (the W_z search then starts from its own guess).
+
+    Parameters
+    ----------
+    trial : str, optional
+        A key of :data:`mutext.examples.three_mass.TRIALS`.
+    out : file-like, optional
+        Where the log is written.
+    measured : mutext.rig.FRF, optional
+        A measured sweep that replaces the true model.
+    progress : callable, optional
+        ``progress(stage, fraction)`` of the W_z search.
+    real : bool, optional
+        Keep the uncertain parameters real in the design.
+    branch : bool, optional
+        Judge the tries by branch and bound.
+    weight : {"flat", "spread"}, optional
+        Shape of the error bound.
+    dk_options : dict, optional
+        Added to the D-K options of each try.
+    """
     tr = three_mass.TRIALS[trial]
     t0 = time.perf_counter()
     args = three_mass.mbi_arguments(tr)
@@ -108,7 +147,15 @@ def solve(trial: str = "1a", out=sys.stderr, measured=None, progress=None, real:
 
 def figure(r, samples: int = 8):
     """The MBI figure of a :func:`solve` result, with true systems sampled at random
-    vertices of the uncertainty box (thesis Figs. 3.13-3.15 analogues)."""
+    vertices of the uncertainty box (thesis Figs. 3.13-3.15 analogues).
+
+    Parameters
+    ----------
+    r : dict
+        The result of :func:`solve`.
+    samples : int, optional
+        Number of true systems drawn at vertices of the uncertainty box.
+    """
     from .. import plots
     tr = three_mass.TRIALS[r["trial"]]
     if r["result"].measured_fit is not None:      # the model fitted to the measured sweep
@@ -122,6 +169,18 @@ def figure(r, samples: int = 8):
 
 
 def run(args) -> int:
+    """Run the subcommand with the parsed ``args``.
+
+    Parameters
+    ----------
+    args : argparse.Namespace
+        The parsed command line.
+
+    Returns
+    -------
+    int
+        The exit status.
+    """
     if getattr(args, "plots", None) is not None:
         from .._files import output_directory
         output_directory(args.plots, "--plots")     # checked before the work, not after it

@@ -17,6 +17,13 @@ from ..hinf import hinfsyn, slycot_hinfsyn
 
 
 def add_arguments(p):
+    """Declare the subcommand's options on ``p``.
+
+    Parameters
+    ----------
+    p : argparse.ArgumentParser
+        The subcommand's parser.
+    """
     p.add_argument("--json", action="store_true", help="print one JSON object instead of a report")
     p.add_argument("--plots", metavar="DIR", help="save Figures 2.6-2.8 analogues (PNG) in DIR")
     p.add_argument("--exact-weights", action="store_true",
@@ -24,13 +31,27 @@ def add_arguments(p):
 
 
 def slycot_gamma(P, nmeas, ncon):
-    """Reference level from python-control/slycot (Riccati method); nan unless its controller confirms it."""
+    """Reference level from python-control/slycot (Riccati method); nan unless its controller confirms it.
+
+    Parameters
+    ----------
+    P : control.StateSpace
+        The generalized plant.
+    nmeas, ncon : int
+        Numbers of measurements and controls.
+    """
     ref = slycot_hinfsyn(P, nmeas, ncon, timeout=30.0)
     return ref.gamma if ref.status == "verified" else float("nan")
 
 
 def solve(params=two_mass.THESIS):
-    """Everything the demo, the book and the tests report, as a dict."""
+    """Everything the demo, the book and the tests report, as a dict.
+
+    Parameters
+    ----------
+    params : mutext.examples.two_mass.TwoMass, optional
+        The problem's parameters (default: the thesis's, with its rounded weights).
+    """
     t0 = time.perf_counter()
     P = two_mass.plant(params)
     res = hinfsyn(P, 1, 1)
@@ -53,6 +74,18 @@ def solve(params=two_mass.THESIS):
 
 
 def run(args) -> int:
+    """Run the subcommand with the parsed ``args``.
+
+    Parameters
+    ----------
+    args : argparse.Namespace
+        The parsed command line.
+
+    Returns
+    -------
+    int
+        The exit status.
+    """
     if getattr(args, "plots", None) is not None:
         from .._files import output_directory
         output_directory(args.plots, "--plots")     # checked before the work, not after it

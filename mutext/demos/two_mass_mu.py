@@ -23,6 +23,13 @@ from ..lti import hinf_norm, lft_lower
 
 
 def add_arguments(p):
+    """Declare the subcommand's options on ``p``.
+
+    Parameters
+    ----------
+    p : argparse.ArgumentParser
+        The subcommand's parser.
+    """
     p.add_argument("--xmax", type=float, default=0.035,
                    help="allowed displacement of m1 in m (thesis: 0.035, relaxed to 0.041; mu < 1 here from about 0.043)")
     p.add_argument("--json", action="store_true", help="print one JSON object instead of a report")
@@ -40,6 +47,15 @@ def add_arguments(p):
 def check_controller(K, x_max: float, rel: float = 0.02) -> dict:
     """Closed loops of ``K`` with the plant rebuilt at the nominal parameters and at the
     16 corners of the +/- ``rel`` box.
+
+    Parameters
+    ----------
+    K : control.StateSpace
+        The controller.
+    x_max : float
+        Allowed displacement of m1 [m] of the plant.
+    rel : float, optional
+        Relative half-width of the parameter box.
 
     Returns
     -------
@@ -74,7 +90,24 @@ def solve(x_max: float = 0.035, max_iter: int = 6, out=sys.stderr, progress=None
     :func:`mutext.dk.refine_controller` if asked, and the checks; everything the demo and the
     tests report.
 
-    ``progress(stage, fraction)`` is passed to the iteration."""
+    ``progress(stage, fraction)`` is passed to the iteration.
+
+    Parameters
+    ----------
+    x_max : float, optional
+        Allowed displacement of m1 [m].
+    max_iter : int, optional
+        Largest number of D-K iterations.
+    out : file-like, optional
+        Where the log is written.
+    progress : callable, optional
+        ``progress(stage, fraction)`` for the long steps.
+
+    real : bool, optional
+        D-G-K iteration with the parameters kept real.
+    refine : int, optional
+        Steps of :func:`mutext.dk.refine_controller` after the iteration (0: none).
+    """
     t0 = time.perf_counter()
     P = tmu.plant(x_max)
     # a scaling budget of 16 added states (the default is 12): on this problem it
@@ -120,6 +153,18 @@ def solve(x_max: float = 0.035, max_iter: int = 6, out=sys.stderr, progress=None
 
 
 def run(args) -> int:
+    """Run the subcommand with the parsed ``args``.
+
+    Parameters
+    ----------
+    args : argparse.Namespace
+        The parsed command line.
+
+    Returns
+    -------
+    int
+        The exit status.
+    """
     from ..errors import ModelError
     if not (np.isfinite(args.xmax) and args.xmax > 0):
         raise ModelError(f"--xmax must be a positive length in m, got {args.xmax}")
