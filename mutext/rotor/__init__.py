@@ -102,5 +102,18 @@ __all__ = [
 
 
 def data_path(name: str) -> str:
-    """Path of a file shipped in ``mutext/data`` (e.g. ``"rotor.toml"``, ``"rotor_healthy.txt"``)."""
+    """Path of a file shipped in ``mutext/data`` (e.g. ``"rotor.toml"``, ``"rotor_healthy.txt"``).
+
+    Parameters
+    ----------
+    name : str
+        File name inside ``mutext/data``.
+
+    Examples
+    --------
+    >>> import os
+    >>> from mutext.rotor import data_path
+    >>> os.path.basename(data_path("rotor.toml")), os.path.exists(data_path("rotor.toml"))
+    ('rotor.toml', True)
+    """
     return os.path.join(os.path.dirname(os.path.dirname(os.path.abspath(__file__))), "data", name)
