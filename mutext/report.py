@@ -14,7 +14,7 @@ from ._mpl import db as _db, pyplot as _plt, save as _save
 from .diagnose import Diagnosis, write_model
 from .jsonio import to_json as _to_json
 
-__all__ = ["write_diagnosis", "to_json", "diagnosis_figures"]
+__all__ = ["write_diagnosis", "to_json", "diagnosis_figures", "mbi_lines"]
 
 
 
@@ -133,7 +133,90 @@ def diagnosis_figures(result, outdir) -> list[str]:
         ax[1].set_ylabel("phase [deg]")
         ax[1].set_xlabel("frequency [Hz]")
         paths.append(_save(fig, outdir, "impedance.png"))
+    imp = (result.mbi or {}).get("impedance")
+    if imp:
+        paths.append(_mbi_figure(plt, result.mbi, outdir))
     return paths
+
+
+def _complex(pairs) -> np.ndarray:
+    return np.array([complex(a, b) for a, b in pairs])
+
+
+def _mbi_figure(plt, m: dict, outdir) -> str:
+    """``mbi_impedance.png``: the controller K beside the impedance the data require, frequency by frequency."""
+    imp = m["impedance"]
+    f = np.asarray(imp["freq_hz"])
+    K, D = _complex(imp["K"]), _complex(imp["required"])
+    band = np.asarray(imp["band"], bool)
+    el = m.get("element")
+    fig, ax = plt.subplots(2, 1, figsize=(6.5, 4.5), sharex=True)
+    ax[0].semilogy(f, np.abs(D), ".", ms=3, color="0.4", label="required (one value per frequency)")
+    ax[0].semilogy(f, np.abs(K), "-", color="C0", label="controller K (D-K iteration)")
+    ax[1].plot(f, np.degrees(np.angle(D)), ".", ms=3, color="0.4")
+    ax[1].plot(f, np.degrees(np.angle(K)), "-", color="C0")
+    if el is not None and el.get("kind") == "mass-damper-spring":
+        # the element written is K's reading; beside K where it differs
+        w = 2 * np.pi * f
+        z = el["dk"] + 1j * w * el["dc"] - w * w * el["dm"]
+        ax[0].semilogy(f, np.abs(z), "--", color="C1", label="element written (mass, damper, spring)")
+        ax[1].plot(f, np.degrees(np.angle(z)), "--", color="C1")
+    for a in ax:
+        # shade what lies outside the identifiable band, where the data do not hold K
+        for k in np.flatnonzero(~band):
+            a.axvspan(f[max(k - 1, 0)], f[min(k + 1, f.size - 1)], color="0.92", lw=0)
+    ax[0].set_ylabel("|K| [N/m]")
+    ax[0].legend(fontsize=7)
+    ax[0].set_title(f"impedance at {m.get('location')}: the controller and what the data require\n"
+                    "(grey: outside the identifiable band)", fontsize=9)
+    ax[1].set_ylabel("phase [deg]")
+    ax[1].set_xlabel("frequency [Hz]")
+    return _save(fig, outdir, "mbi_impedance.png")
+
+
+def mbi_lines(result: Diagnosis, rows: int = 6) -> list[str]:
+    """Text lines on the controller as an element of the model: what was written, its held-out gain, and
+    K beside the required impedance at ``rows`` frequencies of the identifiable band (empty when the
+    diagnosis ran no element)."""
+    m = result.mbi or {}
+    el = m.get("element")
+    if not el:
+        return []
+    out = [f"controller as an element at {m['location']}: {el['description']}",
+           f"  held-out gain {m['held_out_gain']:.3g}x ({100 * m['held_out_error']['rel']:.3g} % rms against "
+           f"{100 * result.error_before['rel']:.3g} % for the engineering model); {m['status']}"]
+    if m.get("extended_model"):
+        out.append(f"  written: {m['extended_model']}")
+    imp = m.get("impedance")
+    if imp:
+        f = np.asarray(imp["freq_hz"])
+        band = np.flatnonzero(np.asarray(imp["band"], bool))
+        K, D = _complex(imp["K"]), _complex(imp["required"])
+        out.append(f"  K against the required impedance on the identifiable band: {100 * imp['band_error']:.3g} % "
+                   "rms (sensitivity-weighted)")
+        out.append(f"  {'f [Hz]':>9} {'|K| [N/m]':>11} {'|required|':>11} {'phase K':>8} {'required':>9}")
+        for k in (band[np.linspace(0, band.size - 1, min(rows, band.size)).round().astype(int)] if band.size
+                  else []):
+            out.append(f"  {f[k]:9.4g} {abs(K[k]):11.4g} {abs(D[k]):11.4g} {np.degrees(np.angle(K[k])):7.1f}d "
+                       f"{np.degrees(np.angle(D[k])):8.1f}d")
+    return out
+
+
+def _mbi_html(r: Diagnosis) -> str:
+    """The controller as an element of the model, in the HTML report."""
+    m = r.mbi or {}
+    el = m.get("element")
+    if not el:
+        return ""
+    e = html.escape
+    return (f"<h2>What no hypothesis names: the controller as an element</h2>"
+            f"<p>Model-based identification at {e(str(m['location']))}: {e(m['reading'])}.</p>"
+            f"<p>Written as: {e(el['description'])}; held-out gain {m['held_out_gain']:.3g}x "
+            f"({100 * m['held_out_error']['rel']:.3g} % rms complex error); {e(m['status'])}"
+            + (f"; file <code>{e(m['extended_model'])}</code>" if m.get("extended_model") else "")
+            + f".</p><pre>{e(m['element_text'])}</pre>"
+            "<p>The figure <code>mbi_impedance.png</code> shows K beside the impedance the data require "
+            "frequency by frequency.</p>")
 
 
 def _quality_html(r: Diagnosis) -> str:
@@ -207,6 +290,7 @@ false-alarm rate {100 * r.alpha:g} %)</h2>
 <tr><td>extended model</td><td>{100 * r.error_after['rel']:.3g} %</td><td>{r.error_after['db']:.3g} dB</td></tr>
 </table><p>Gain: {r.gain:.3g}x.</p>
 {f'<p>Extended model: <code>{e(r.extended_model)}</code></p>' if r.extended_model else ''}
+{_mbi_html(r)}
 <h2>Figures</h2>{imgs}
 {f'<h2>Notes</h2><ul>{notes}</ul>' if notes else ''}
 <p><small>{r.seconds:.1f} s</small></p></body></html>

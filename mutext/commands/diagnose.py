@@ -80,7 +80,7 @@ def run(args) -> int:
     from ..diagnose import diagnose
     from ..errors import ModelError
     from ..progress import ProgressLine
-    from ..report import to_json, write_diagnosis
+    from ..report import mbi_lines, to_json, write_diagnosis
     from ..rig import read_frfs
     prog = ProgressLine(enabled=not args.quiet)
     if args.batch:
@@ -100,6 +100,8 @@ def run(args) -> int:
         print(to_json(res))
     else:
         print(res.report())
+        for line in mbi_lines(res):
+            print(line)
         if args.out:
             print(f"report: {args.out}/report.html")
     sys.stdout.flush()

@@ -5,6 +5,7 @@ import logging
 import math
 import os
 import time
+from dataclasses import replace
 from typing import Callable
 
 import numpy as np
@@ -17,7 +18,7 @@ from ..rig import read_frfs
 from ..rotor.model import load_model, loads_model
 from ..rotor.tuning import model_response
 from ._compare import _errors, _model_modes, _resonance_table, _summary
-from ._extend import _refit, extended_model_text, mbi_reading, write_model
+from ._extend import _identify_at, _refit, extended_model_text, mbi_element, write_model
 from ._hypotheses import Hypothesis, hypotheses
 from .faults import channel as _channel
 from .faults import structure as _structure
@@ -253,17 +254,44 @@ def _diagnose(model, frfs, validate, alpha, refit, noise, out_dir, progress, onl
                      h.description, hypothesis=h)
     if mbi and at is not none:
         tell("model-based identification at the finding (D-K iteration)", 0.97)
+        # the controller is tuned on the first channel's fitted lines only: the held-out lines, on which the
+        # element it becomes is judged, stay unseen
+        k0 = 0 if at is verdict else _channel_at(fit.chans, at.station)
+        c0 = fit.chans[k0]
+        seen = replace(c0.frf, freq_hz=fit.freq_hz[k0], response=fit.meas[k0], metadata=dict(c0.frf.metadata))
         try:
-            result.mbi = mbi_reading(model_text, path, at, chans[0].frf, chans[0].in_name,
-                                     chans[0].out_name, progress=lambda stage, frac: tell(
-                                         f"model-based identification: {stage}", 0.97 + 0.02 * frac))
+            result.mbi, res, E = _identify_at(model_text, path, at, seen, c0.in_name, c0.out_name,
+                                              progress=lambda stage, frac: tell(
+                                                  f"model-based identification: {stage}", 0.97 + 0.02 * frac))
         except ModelError as exc:
             result.mbi = {"location": None, "reading": f"not run: {exc}", "agrees": None}
+        else:
+            if at is not verdict:
+                # nothing the hypotheses name explains the data: K itself becomes the element of the model
+                tell("the controller as an element of the model, judged on the held-out data", 0.99)
+                try:
+                    result.mbi.update(mbi_element(result.mbi, res, E, model_text, eng, localized["station"],
+                                                  localized["dof"], rec, held, s2, ref, alpha, seen, c0.in_name,
+                                                  c0.out_name, err_before))
+                except ModelError as exc:
+                    result.mbi["element"] = None
+                    result.notes.append(f"the controller was not written as an element: {exc}")
         result.seconds = time.perf_counter() - t0
     if out_dir is not None:
         write_model(result, out_dir)
     tell("done", 1.0)
     return result
+
+
+def _channel_at(chans, station: int) -> int:
+    """The channel that sees a station best: its driving point, else one that measures or drives it, else the
+    first.  (A controller tuned on a channel where the station hardly moves is free where it does not.)"""
+    for test in (lambda c: c.frf.input_station == station and c.frf.output_station == station,
+                 lambda c: c.frf.output_station == station, lambda c: c.frf.input_station == station):
+        k = next((k for k, c in enumerate(chans) if test(c)), None)
+        if k is not None:
+            return k
+    return 0
 
 
 def _breathing(findings, sidebands, model_text, path, speed, chans, fit, held, s2, rss0, verdict, err_after,

@@ -5,6 +5,9 @@ import math
 import os
 import time
 from dataclasses import replace
+
+import numpy as np
+
 from ..errors import ModelError
 from ..response import FRF
 from ..rotor.model import loads_model
@@ -50,6 +53,7 @@ def write_model(result: Diagnosis, out_dir) -> str | None:
     name; any other extended model is written as ``model_extended_NOT_CONFIRMED.toml`` with the
     diagnosis's status in its first lines."""
     if result.extended_model_text is None:
+        write_mbi_model(result, out_dir)
         return None
     import shutil
     import tomllib
@@ -74,6 +78,7 @@ def write_model(result: Diagnosis, out_dir) -> str | None:
     with open(out, "w", encoding="utf-8") as fh:
         fh.write(text)
     result.extended_model = out
+    write_mbi_model(result, out_dir)
     return out
 
 
@@ -95,6 +100,12 @@ def mbi_reading(model_text: str, path: str, finding: Finding, frf: FRF, excitati
     damper) have a single controller location; other findings raise ModelError.
     ``progress(stage, fraction)`` is passed to :func:`mutext.mbi.identify`.
     """
+    return _identify_at(model_text, path, finding, frf, excitation, measurement, progress)[0]
+
+
+def _identify_at(model_text, path, finding, frf, excitation, measurement, progress=None):
+    """:func:`mbi_reading`'s dict, the :class:`mutext.mbi.MBIResult` and the engineering model with the
+    controller's ports (``u_mbi``, ``y_mbi``)."""
     import tomllib
     from ..mbi import identify       # D-K iteration: imported only when asked for (--mbi)
     h = finding.hypothesis
@@ -119,11 +130,152 @@ def mbi_reading(model_text: str, path: str, finding: Finding, frf: FRF, excitati
     v = float(getattr(fit, coef[0]))
     sd = max(float(fit.sigma[coef[1]]), float(fit.residual) * abs(v))
     comb = math.sqrt(sd ** 2 + finding.std ** 2)
-    return {"location": mass, "reading": fit.description, "mu": float(res.mu_upper), "Wz": float(res.Wz),
-            "dm": float(fit.dm), "dc": float(fit.dc), "dk": float(fit.dk),
-            "sigma": [float(x) for x in fit.sigma], "residual": float(fit.residual),
-            "compared": coef[0], "mbi_value": v, "mbi_std": sd, "diagnosis_value": finding.value,
-            "agrees": bool(abs(v - finding.value) <= 3 * comb), "seconds": time.perf_counter() - t0}
+    return ({"location": mass, "reading": fit.description, "mu": float(res.mu_upper), "Wz": float(res.Wz),
+             "dm": float(fit.dm), "dc": float(fit.dc), "dk": float(fit.dk),
+             "sigma": [float(x) for x in fit.sigma], "residual": float(fit.residual),
+             "compared": coef[0], "mbi_value": v, "mbi_std": sd, "diagnosis_value": finding.value,
+             "agrees": bool(abs(v - finding.value) <= 3 * comb), "seconds": time.perf_counter() - t0},
+            res, E)
+
+
+#: Largest sensitivity-weighted RMS relative difference between the written rational element and the
+#: controller K (the order of the element is raised until it is within this).
+ELEMENT_TOL = 0.01
+
+
+def _physical(fit, host_mass: float) -> bool:
+    """A mass-damper-spring reading that is one: it describes K, the damper and spring are not negative
+    and the host keeps a positive mass."""
+    return bool(fit.fits and fit.dc >= 0 and fit.dk >= 0 and host_mass + fit.dm > 0)
+
+
+def realise_controller(res, host_mass: float, tol: float = ELEMENT_TOL) -> dict:
+    r"""The identified controller :math:`K(s)` as an element the model file can hold.
+
+    When its mass-damper-spring reading (:attr:`mutext.mbi.MBIResult.fit`) describes
+    ``K`` on its identifiable band with a damper and a spring that are not negative
+    and a host mass that stays positive (:math:`m + \Delta m > 0`), the element is
+    that mass change with a spring and a damper to ground.  Otherwise it is a rational
+    impedance :math:`K(s) = N(s)/D(s)` (``[[impedance]]``,
+    :class:`mutext.rotor.lumped_elements.Impedance`): ``K`` reduced by balanced
+    truncation that keeps the static gain (:func:`control.balred`, ``matchdc``) to the lowest order whose
+    response differs from ``K``'s by at most ``tol`` (RMS relative, each frequency
+    of the search grid weighted by the sensitivity :math:`|s(\omega)|` of
+    :func:`mutext.mbi.identifiable_band`, i.e. by how much it moves the measured
+    output), and whose loop with the engineering model stays stable.
+
+    Returns
+    -------
+    dict
+        ``kind`` (``"mass-damper-spring"`` or ``"impedance"``), the coefficients
+        (``dm, dc, dk`` or ``numerator, denominator`` in descending powers of
+        :math:`s`), ``order`` (states added), ``realisation_error`` (the weighted
+        difference from ``K`` on the grid, for the impedance), ``description``.
+    """
+    import control as ct
+    from ..lti import freqresp
+    from ..mbi import controlled_engineering, identifiable_band, relative_error
+    from ..rotor.lumped_elements import Impedance
+    fit = res.fit
+    if _physical(fit, host_mass):
+        return {"kind": "mass-damper-spring", "dm": float(fit.dm), "dc": float(fit.dc), "dk": float(fit.dk),
+                "order": 0, "realisation_error": float(fit.residual),
+                "description": f"mass {fit.dm:+.4g} kg at the host, spring {fit.dk:.4g} N/m and damper "
+                               f"{fit.dc:.4g} N s/m to ground"}
+    K = res.K
+    omega = np.asarray(res.omega, float)
+    sens, _ = identifiable_band(res.plant, K, omega)
+    Kj = freqresp(K, omega)[0, 0]
+    best = None
+    for r in range(1, K.nstates + 1):
+        try:
+            Kr = K if r == K.nstates else ct.balred(K, r, method="matchdc")
+            tf = ct.ss2tf(Kr)
+            num = np.atleast_1d(np.squeeze(tf.num[0][0])).astype(float)
+            den = np.atleast_1d(np.squeeze(tf.den[0][0])).astype(float)
+            num, den = num / den[0], den / den[0]
+            el = Impedance(1, num, den, name="K")
+        except Exception as exc:      # noqa: BLE001 -- slycot and python-control raise their own kinds
+            # a reduction or conversion that fails at this order: the next order is tried
+            best = best or ("error", str(exc))
+            continue
+        err = relative_error(el.response(omega), Kj, omega, weight=sens)
+        if not err <= tol:
+            continue
+        # the loop of the engineering model with the written element must be stable
+        A = np.asarray(controlled_engineering(res.plant, ct.ss(*el.realisation())).A, float)
+        if A.size and np.max(np.linalg.eigvals(A).real) >= 0:
+            continue
+        return {"kind": "impedance", "numerator": num.tolist(), "denominator": den.tolist(),
+                "order": int(den.size - 1), "realisation_error": float(err),
+                "description": f"rational impedance of order {den.size - 1} to ground ("
+                               + (f"K reduced from order {K.nstates}" if r < K.nstates else "K's own order")
+                               + f"; it differs from K by {100 * err:.2g} % rms, sensitivity-weighted)"}
+    why = f" ({best[1]})" if best else ""
+    raise ModelError(f"the controller (order {K.nstates}) has no stable realisation as a rational impedance "
+                     f"within {100 * tol:g} % of its response{why}")
+
+
+def element_response(element: dict, omega) -> np.ndarray:
+    r"""The element's dynamic stiffness :math:`z(\omega)` [N/m] at ``omega`` [rad/s]."""
+    w = np.asarray(omega, float)
+    if element["kind"] == "mass-damper-spring":
+        return element["dk"] + 1j * w * element["dc"] - w * w * element["dm"]
+    s = 1j * w
+    return np.polyval(element["numerator"], s) / np.polyval(element["denominator"], s)
+
+
+def element_model_text(model_text: str, element: dict, mass: str, host_mass: float, note: str) -> str:
+    """The model file's text with the realised controller (:func:`realise_controller`) at ``mass``."""
+    mf = ModelFile(model_text)
+    if element["kind"] == "mass-damper-spring":
+        mf.set("mass", lambda t: t.get("name") == mass, "mass", host_mass + element["dm"], note)
+        mf.append("spring", {"name": f"k_mbi_{mass}", "stiffness": element["dk"], "between": [mass, "ground"]},
+                  note)
+        mf.append("damper", {"name": f"c_mbi_{mass}", "damping": element["dc"], "between": [mass, "ground"]},
+                  note)
+    else:
+        mf.append("impedance", {"name": f"K_mbi_{mass}", "mass": mass, "numerator": element["numerator"],
+                                "denominator": element["denominator"]}, note)
+    return f"# Extended by mutext diagnose: {note}\n" + mf.text()
+
+
+def with_impedance(rec, data, dof: int, z_of) -> list:
+    r"""The channels of ``data`` with a dynamic stiffness :math:`z(\omega)` to ground at ``dof`` (exact).
+
+    Sherman-Morrison on the engineering model's receptance :math:`R`:
+    :math:`H_c = H^0_c - z R_{od} R_{db} / (1 + z R_{dd})`."""
+    out = []
+    for k, idx in enumerate(data.idx):
+        Rb, Ro = data.columns(rec, k)
+        z = z_of(rec.omega[idx])
+        out.append(data.H0[k] - z * Ro[:, dof] * Rb[:, dof] / (1 + z * rec.R[idx, dof, dof]))
+    return out
+
+
+def impedance_comparison(res, E, frf: FRF, excitation: str, measurement: str) -> dict:
+    r"""K's frequency response beside the impedance the data require, on ``frf``'s frequencies.
+
+    The required impedance is :func:`mutext.mbi.required_impedance` (one value per
+    frequency, no fit); the identifiable band is where :math:`|s K| \ge 1`
+    (:func:`mutext.mbi.identifiable_band`).  ``band_error`` is the RMS relative
+    difference :math:`|K - D|/|D|` over the band's frequencies, each weighted by
+    :math:`|s|` (``sensitivity``; :func:`mutext.mbi.relative_error`); complex
+    values are ``[re, im]`` pairs."""
+    from ..lti import freqresp
+    from ..mbi import identifiable_band, relative_error, required_impedance
+    w = 2 * np.pi * np.asarray(frf.freq_hz, float)
+    D = required_impedance(E, frf, excitation=excitation, measurement=measurement, control_input="u_mbi",
+                           control_output="y_mbi")
+    Kj = freqresp(res.K, w)[0, 0]
+    sens, band = identifiable_band(res.plant, res.K, w)
+    ok = band & np.isfinite(D)
+    err = relative_error(Kj[ok], D[ok], w[ok], weight=sens[ok]) if ok.sum() >= 1 else math.nan
+    pair = lambda z: [[float(x.real), float(x.imag)] for x in z]    # noqa: E731
+    return {"freq_hz": [float(x) for x in frf.freq_hz], "K": pair(Kj), "required": pair(D),
+            "band": [bool(x) for x in band], "sensitivity": [float(x) for x in sens], "band_error": float(err),
+            "band_hz": [float(w[band].min() / (2 * np.pi)), float(w[band].max() / (2 * np.pi))]
+            if band.any() else None}
 
 
 def _refit(f: Finding, model_text, path, eng, fit: _Data, s2, N, rss0, threshold, progress=None):
@@ -153,3 +305,85 @@ def _refit(f: Finding, model_text, path, eng, fit: _Data, s2, N, rss0, threshold
     f.score = rss / s2 + math.log(N)
     f.significant = bool(f.delta_chi2 > threshold)
     f.refit = True
+
+
+def mbi_element(reading: dict, res, E, model_text: str, eng, station: int, dof: int, rec, held: _Data, s2: float,
+                ref, alpha: float, frf: FRF, excitation: str, measurement: str, err_before: dict) -> dict:
+    r"""The identified controller as an element of the extended model, judged on the held-out data.
+
+    :func:`realise_controller` gives the element at ``station``; the held-out
+    channels with it are computed exactly from the engineering model's
+    receptance (:func:`with_impedance`) and checked against the written model
+    file read back; the gain is the engineering model's held-out RMS complex
+    error over the extended model's, as for the diagnosis's own effects, and
+    the lack-of-fit test of :func:`mutext.diagnose._fit_quality.fit_quality`
+    says whether the held-out data are then at the noise.
+
+    Returns
+    -------
+    dict
+        Added to :attr:`Diagnosis.mbi`: ``element`` (see :func:`realise_controller`),
+        ``element_text`` (the TOML the model file gains), ``extended_model_text``,
+        ``held_out_error``, ``held_out_gain``, ``held_out_quality``, ``status``
+        (``"explained"`` when the gain exceeds 1 and the held-out data are at
+        the noise, else ``"not explained"``) and ``impedance``
+        (:func:`impedance_comparison`).
+    """
+    from ._compare import _errors
+    from ._fit_quality import fit_quality
+    host = eng.layout.node_names[station - 1]
+    host_mass = float(eng.parameter(host).value)
+    el = realise_controller(res, host_mass)
+    after = with_impedance(rec, held, dof, lambda w: element_response(el, w))
+    note = f"model-based identification: {el['description']} at {host}"
+    text = element_model_text(model_text, el, host, host_mass, note)
+    # the file as written must give the responses the gain is measured on
+    ext = loads_model(text, source="extended model (controller element)")
+    c0 = held.chans[0]
+    H = ext.frf(held.freq_hz[0], inputs=[c0.in_name], outputs=[c0.out_name]).H[0, 0]
+    mism = float(np.max(np.abs(H - after[0]) / np.abs(after[0])))
+    if not mism < 1e-6:
+        raise ModelError(f"the extended model with the controller element does not reproduce the responses its "
+                         f"gain is measured on (largest relative difference {mism:.3g})")
+    err_after = _errors(after, held.meas)
+    gain = err_before["rel"] / err_after["rel"] if err_after["rel"] > 0 else math.inf
+    with np.errstate(all="ignore"):
+        hq = fit_quality([np.log(h / m) for h, m in zip(after, held.meas)], held.freq_hz,
+                         [c.label for c in held.chans], s2, 0, ref, alpha)
+    status = "explained" if gain > 1 and hq.at_noise else "not explained"
+    snippet = ModelFile("")
+    if el["kind"] == "mass-damper-spring":
+        snippet.append("spring", {"name": f"k_mbi_{host}", "stiffness": el["dk"], "between": [host, "ground"]})
+        snippet.append("damper", {"name": f"c_mbi_{host}", "damping": el["dc"], "between": [host, "ground"]})
+        element_text = f"# [[mass]] {host}: mass = {host_mass + el['dm']!r} (was {host_mass!r})\n" + snippet.text()
+    else:
+        snippet.append("impedance", {"name": f"K_mbi_{host}", "mass": host, "numerator": el["numerator"],
+                                     "denominator": el["denominator"]})
+        element_text = snippet.text()
+    return {"element": el, "element_text": element_text.strip() + "\n", "extended_model_text": text,
+            "held_out_error": err_after, "held_out_gain": float(gain), "held_out_quality": hq.as_dict(),
+            "status": status, "impedance": impedance_comparison(res, E, frf, excitation, measurement)}
+
+
+def write_mbi_model(result: Diagnosis, out_dir) -> str | None:
+    """Write the extended model with the controller element (:func:`mbi_element`), when there is one.
+
+    ``model_extended.toml`` when its status is explained (held-out gain above 1 and
+    the held-out data at the noise) and the diagnosis's own extended model is not a
+    confirmed fix; otherwise ``model_extended_mbi_NOT_CONFIRMED.toml``, its status
+    in its first lines.  The path is kept in ``result.mbi["extended_model"]``."""
+    m = result.mbi or {}
+    text = m.get("extended_model_text")
+    if not text:
+        return None
+    os.makedirs(out_dir, exist_ok=True)
+    if m["status"] == "explained" and not result.confirmed:
+        out = os.path.join(out_dir, "model_extended.toml")
+    else:
+        out = os.path.join(out_dir, "model_extended_mbi_NOT_CONFIRMED.toml")
+        text = (f"# NOT A CONFIRMED FIX. Model-based identification element: {m['status']}; held-out gain "
+                f"{m['held_out_gain']:.3g}x.\n" + text)
+    with open(out, "w", encoding="utf-8") as fh:
+        fh.write(text)
+    m["extended_model"] = out
+    return out
