@@ -36,7 +36,7 @@ class Finding:
     score : float
         Information criterion (lower is better).
     delta_chi2 : float
-        Improvement of :math:`\chi^2` over *none*.
+        Improvement of :math:`\\chi^2` over *none*.
     description : str
         The hypothesis in words.
     significant : bool
@@ -251,7 +251,7 @@ class Diagnosis:
     summary : list of str
         The comparison in a few sentences.
     threshold : float
-        The :math:`\Delta\chi^2` an effect must exceed (Bonferroni at ``alpha``).
+        The :math:`\\Delta\\chi^2` an effect must exceed (Bonferroni at ``alpha``).
     alpha : float
         The false-alarm rate.
     n_hypotheses : int
