@@ -160,7 +160,7 @@ def thesis():
     return load_model(data_path("rotor.toml"))
 
 
-def test_rig_planar_matrix_keeps_the_one_plane_channels(thesis):
+def test_rig_planar_matrix_keeps_the_one_plane_channels(thesis, tmp_path):
     from mutext.rig import measure_rotor
     f = np.arange(20.0, 225.0, 0.5)
     P = measure_rotor(thesis, "i12", "x13", f, planes="xy")
@@ -175,6 +175,14 @@ def test_rig_planar_matrix_keeps_the_one_plane_channels(thesis):
     scale = np.max(np.abs(P["yy"].response))
     assert np.max(np.abs(P["xy"].response - 40.0 * H("x13", "F12y"))) <= 1e-9 * scale
     assert np.max(np.abs(P["yy"].response - 40.0 * H("y13", "F12y"))) <= 1e-9 * scale
+    # the four channels as FRFs (as read from four files) give the same dFRFs
+    from mutext.rig import read_frf, write_frf
+    path = tmp_path / "xy.csv"
+    write_frf(path, P["xy"])
+    back = read_frf(path)
+    assert (back.input_direction, back.output_direction) == ("y", "x")
+    d = directional_frf([[P["xx"], back], [P["yx"], P["yy"]]])
+    assert np.allclose(d.pp, P.directional().pp, rtol=1e-12, atol=0)
     # an isotropic rotor: H_yy = H_xx, H_xy = -H_yx
     assert np.max(np.abs(P["yy"].response - P["xx"].response)) <= 1e-8 * scale
     assert np.max(np.abs(P["xy"].response + P["yx"].response)) <= 1e-8 * scale
