@@ -183,7 +183,7 @@ def test_a_peak_the_refinement_grid_missed_joins_it_and_the_descent_goes_on(monk
     frequencies join the grid and ``regrid_every`` more steps follow, then the fine grid is
     checked again.  Here the first check is made to report a peak 5 % higher at a frequency
     off the grid; a run stopped by its time limit is not continued."""
-    import mutext.dk as dk
+    import mutext.dk._refine as dk          # where refine_controller looks the analysis up
     P, S, K = _small_problem()
     real = dk._final_analysis
     calls = []
