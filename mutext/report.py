@@ -175,9 +175,21 @@ def _mbi_figure(plt, m: dict, outdir) -> str:
 
 
 def mbi_lines(result: Diagnosis, rows: int = 6) -> list[str]:
-    """Text lines on the controller as an element of the model: what was written, its held-out gain, and
-    K beside the required impedance at ``rows`` frequencies of the identifiable band (empty when the
-    diagnosis ran no element)."""
+    """Text lines on the controller as an element of the model (what ``mutext diagnose --mbi`` prints).
+
+    Parameters
+    ----------
+    result : Diagnosis
+        A diagnosis run with ``mbi=True``.
+    rows : int
+        Frequencies of the identifiable band at which K and the required impedance are tabulated.
+
+    Returns
+    -------
+    list of str
+        What was written, its held-out gain, and the table; empty when the diagnosis made no element
+        (the hypotheses explained the data, or model-based identification was not run).
+    """
     m = result.mbi or {}
     el = m.get("element")
     if not el:

@@ -88,6 +88,13 @@ def diagnose(model, frfs, validate=None, *, alpha: float = 0.01, refit: int = 3,
         identification (:func:`mutext.mbi.identify`, D-K iteration) with the
         controller at the finding's mass, K read as mass, damper and spring,
         compared with the diagnosis (``Diagnosis.mbi``).  Takes 5-60 s more.
+        When the hypotheses do not explain the data, the controller goes to the
+        station the misfit is localized to, is tuned on the fitted lines of the
+        channel that sees that station best, and becomes an element of its own
+        extended model (a mass, spring and damper when its reading is physical,
+        else an ``[[impedance]]``), judged on the held-out lines
+        (``Diagnosis.mbi["element"]``, ``["held_out_gain"]``, ``["status"]``;
+        :func:`mutext.diagnose._extend.mbi_element`).
     only : callable(Hypothesis) -> bool, optional
         Test only the hypotheses it accepts (e.g. a fit told the kind and the
         location: ``only=lambda h: (h.kind, h.station) == ("mass", 3)``); the

@@ -164,6 +164,15 @@ def realise_controller(res, host_mass: float, tol: float = ELEMENT_TOL) -> dict:
     :func:`mutext.mbi.identifiable_band`, i.e. by how much it moves the measured
     output), and whose loop with the engineering model stays stable.
 
+    Parameters
+    ----------
+    res : mutext.mbi.MBIResult
+        The identification: its controller ``K``, reading ``fit``, grid ``omega`` and ``plant``.
+    host_mass : float
+        The mass [kg] the controller acts on, as the model file gives it.
+    tol : float
+        Largest weighted RMS relative difference between the written impedance and ``K``.
+
     Returns
     -------
     dict
@@ -217,7 +226,20 @@ def realise_controller(res, host_mass: float, tol: float = ELEMENT_TOL) -> dict:
 
 
 def element_response(element: dict, omega) -> np.ndarray:
-    r"""The element's dynamic stiffness :math:`z(\omega)` [N/m] at ``omega`` [rad/s]."""
+    r"""The element's dynamic stiffness :math:`z(\omega)` [N/m].
+
+    Parameters
+    ----------
+    element : dict
+        From :func:`realise_controller`.
+    omega : array_like
+        Frequencies [rad/s].
+
+    Returns
+    -------
+    ndarray of complex
+        :math:`dk + j\omega dc - \omega^2 dm`, or :math:`N(j\omega)/D(j\omega)`.
+    """
     w = np.asarray(omega, float)
     if element["kind"] == "mass-damper-spring":
         return element["dk"] + 1j * w * element["dc"] - w * w * element["dm"]
@@ -226,7 +248,25 @@ def element_response(element: dict, omega) -> np.ndarray:
 
 
 def element_model_text(model_text: str, element: dict, mass: str, host_mass: float, note: str) -> str:
-    """The model file's text with the realised controller (:func:`realise_controller`) at ``mass``."""
+    """The model file's text with the realised controller at a mass (the user's comments kept).
+
+    Parameters
+    ----------
+    model_text : str
+        The engineering model file (a lumped chain).
+    element : dict
+        From :func:`realise_controller`.
+    mass : str
+        Name of the mass it acts on.
+    host_mass : float
+        That mass's value [kg] in the file (a mass change is written as the new value).
+    note : str
+        The comment that opens the file and each table written.
+
+    Returns
+    -------
+    str
+    """
     mf = ModelFile(model_text)
     if element["kind"] == "mass-damper-spring":
         mf.set("mass", lambda t: t.get("name") == mass, "mass", host_mass + element["dm"], note)
@@ -244,7 +284,24 @@ def with_impedance(rec, data, dof: int, z_of) -> list:
     r"""The channels of ``data`` with a dynamic stiffness :math:`z(\omega)` to ground at ``dof`` (exact).
 
     Sherman-Morrison on the engineering model's receptance :math:`R`:
-    :math:`H_c = H^0_c - z R_{od} R_{db} / (1 + z R_{dd})`."""
+    :math:`H_c = H^0_c - z R_{od} R_{db} / (1 + z R_{dd})`.
+
+    Parameters
+    ----------
+    rec : mutext.diagnose._screen._Receptance
+        The engineering model's receptance on the diagnosis's grid.
+    data : mutext.diagnose._screen._Data
+        The channels (fitted or held out).
+    dof : int
+        The degree of freedom the element acts on (0-based).
+    z_of : callable
+        ``z_of(omega)``: the element's dynamic stiffness [N/m] at ``omega`` [rad/s].
+
+    Returns
+    -------
+    list of ndarray
+        Per channel, the responses at its frequencies.
+    """
     out = []
     for k, idx in enumerate(data.idx):
         Rb, Ro = data.columns(rec, k)
@@ -261,7 +318,23 @@ def impedance_comparison(res, E, frf: FRF, excitation: str, measurement: str) ->
     (:func:`mutext.mbi.identifiable_band`).  ``band_error`` is the RMS relative
     difference :math:`|K - D|/|D|` over the band's frequencies, each weighted by
     :math:`|s|` (``sensitivity``; :func:`mutext.mbi.relative_error`); complex
-    values are ``[re, im]`` pairs."""
+    values are ``[re, im]`` pairs.
+
+    Parameters
+    ----------
+    res : mutext.mbi.MBIResult
+    E : control.StateSpace
+        The engineering model with the controller's ports ``u_mbi`` and ``y_mbi``.
+    frf : mutext.response.FRF
+        The measured channel the controller was tuned on.
+    excitation, measurement : str
+        Its input and output port names.
+
+    Returns
+    -------
+    dict
+        ``freq_hz``, ``K``, ``required``, ``band``, ``sensitivity``, ``band_error``, ``band_hz``.
+    """
     from ..lti import freqresp
     from ..mbi import identifiable_band, relative_error, required_impedance
     w = 2 * np.pi * np.asarray(frf.freq_hz, float)
@@ -319,6 +392,33 @@ def mbi_element(reading: dict, res, E, model_text: str, eng, station: int, dof: 
     the lack-of-fit test of :func:`mutext.diagnose._fit_quality.fit_quality`
     says whether the held-out data are then at the noise.
 
+    Parameters
+    ----------
+    reading : dict
+        :func:`mbi_reading`'s dict (not changed).
+    res : mutext.mbi.MBIResult
+    E : control.StateSpace
+        The engineering model with the controller's ports.
+    model_text : str
+        The engineering model file.
+    eng : mutext.rotor.assembly.Structure
+        The engineering model (a lumped chain).
+    station, dof : int
+        Where the controller acts: the mass (1-based) and its degree of freedom (0-based).
+    rec, held
+        The engineering model's receptance and the held-out channels of the diagnosis.
+    s2 : float
+        Noise variance of a log residual (real and imaginary part each).
+    ref : mutext.diagnose._fit_quality.NoiseReference
+    alpha : float
+        False-alarm rate of the lack-of-fit test.
+    frf : mutext.response.FRF
+        The channel (fitted lines) the controller was tuned on.
+    excitation, measurement : str
+        Its port names.
+    err_before : dict
+        The engineering model's held-out error (``rel``, ``db``).
+
     Returns
     -------
     dict
@@ -371,7 +471,18 @@ def write_mbi_model(result: Diagnosis, out_dir) -> str | None:
     ``model_extended.toml`` when its status is explained (held-out gain above 1 and
     the held-out data at the noise) and the diagnosis's own extended model is not a
     confirmed fix; otherwise ``model_extended_mbi_NOT_CONFIRMED.toml``, its status
-    in its first lines.  The path is kept in ``result.mbi["extended_model"]``."""
+    in its first lines.  The path is kept in ``result.mbi["extended_model"]``.
+
+    Parameters
+    ----------
+    result : Diagnosis
+    out_dir : path-like
+
+    Returns
+    -------
+    str or None
+        The path written; None when the diagnosis made no element.
+    """
     m = result.mbi or {}
     text = m.get("extended_model_text")
     if not text:

@@ -169,7 +169,17 @@ class Impedance(Element):
         return self.denominator.size - 1
 
     def response(self, omega) -> np.ndarray:
-        r""":math:`K(j\omega)` [N/m] at ``omega`` [rad/s]."""
+        r""":math:`K(j\omega)` [N/m].
+
+        Parameters
+        ----------
+        omega : array_like
+            Frequencies [rad/s].
+
+        Returns
+        -------
+        ndarray of complex
+        """
         s = 1j * np.asarray(omega, float)
         return np.polyval(self.numerator, s) / np.polyval(self.denominator, s)
 
@@ -191,5 +201,16 @@ class Impedance(Element):
 
 
 def impedances(model) -> list:
-    """The :class:`Impedance` elements of ``model`` (empty for a model without)."""
+    """The :class:`Impedance` elements of a model.
+
+    Parameters
+    ----------
+    model : mutext.rotor.assembly.Structure
+        Any assembled model (a rotor holds none).
+
+    Returns
+    -------
+    list of Impedance
+        Empty for a model without.
+    """
     return [el for el in getattr(model, "elements", []) if isinstance(el, Impedance)]
