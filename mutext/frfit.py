@@ -283,6 +283,15 @@ def fit_frf(omega, response, order: int, *, iterations: int = 30, tol: float = 1
     ModelError
         Malformed data, an order that is not a positive integer or larger
         than the number of frequencies (the data cannot determine the model).
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from mutext.frfit import fit_frf
+    >>> w = np.linspace(0.1, 30.0, 300)                 # rad/s
+    >>> fit = fit_frf(w, 1.0 / (100.0 - w ** 2 + 0.2j * w), 2)
+    >>> np.round(np.sort_complex(fit.poles), 4), bool(fit.residual < 1e-10)
+    (array([-0.1+9.9995j]), True)
     """
     w, G = _check_data(omega, response)
     if not (isinstance(order, (int, np.integer)) and not isinstance(order, (bool, np.bool_)) and order >= 1):

@@ -274,6 +274,17 @@ def mck_to_ss(M, C, K, inputs: Mapping[str, object], outputs: Mapping[str, objec
     -------
     control.StateSpace
         With ``inputs``/``outputs`` names taken from the mappings.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from mutext.lti import mck_to_ss
+    >>> G = mck_to_ss([[1.0]], [[0.2]], [[100.0]], inputs={"f": 0},
+    ...               outputs={"x": 0, "v": ("velocity", 0)})     # 1 kg, 100 N/m: 10 rad/s
+    >>> G.input_labels, G.output_labels, G.nstates
+    (['f'], ['x', 'v'], 2)
+    >>> np.round(G.poles(), 3)
+    array([-0.1+9.999j, -0.1-9.999j])
     """
     M = np.atleast_2d(np.asarray(M, dtype=float))
     K = np.atleast_2d(np.asarray(K, dtype=float))
@@ -706,6 +717,13 @@ def sigma_max(sys, omega) -> np.ndarray:
         The continuous-time system.
     omega : float or (N,) array_like
         Frequencies in rad/s.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from mutext.lti import ss, sigma_max
+    >>> np.round(sigma_max(ss([[-1.0]], [[1.0]], [[1.0]], [[0.0]]), [0.0, 1.0]), 4)
+    array([1.    , 0.7071])
     """
     G = freqresp(sys, omega)
     if min(G.shape[:2]) == 0:
@@ -774,6 +792,15 @@ def stability(sys, margin: float = 0.0) -> Stability:
     Stability
         The verdict (truthy when stable), the poles, their thresholds and a
         message naming the deciding pole.
+
+    Examples
+    --------
+    >>> from mutext.lti import ss, stability
+    >>> stability(ss([[-1.0]], [[1.0]], [[1.0]], [[0.0]])).stable
+    True
+    >>> s = stability(ss([[0.0, 1.0], [-1.0, 0.0]], [[0.0], [1.0]], [[1.0, 0.0]], [[0.0]]))   # undamped
+    >>> s.stable, s.message[:26]
+    (False, 'not decidably stable: pole')
     """
     if not is_real_number(margin) or not np.isfinite(margin) or margin < 0:
         raise ModelError(f"stability: margin must be a finite number >= 0 (rad/s), got {margin!r}")

@@ -121,6 +121,16 @@ class FRF:
         entries ``input_direction`` / ``output_direction`` set them.
     input_name, output_name : str or None
         Port names of the model (``"i12"``, ``"x13"``), when known.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from mutext.response import FRF
+    >>> h = FRF(np.array([10.0, 20.0]), np.array([1e-3, 2e-3 + 1e-3j]), input_station=1, output_station=3)
+    >>> h.label, h.unit
+    ('F1->x3', 'm/N')
+    >>> h.band(15.0, 25.0).freq_hz
+    array([20.])
     """
     freq_hz: np.ndarray
     response: np.ndarray

@@ -848,6 +848,18 @@ def write_uff58(path, frfs, *, ordinate: str = "displacement", binary: bool = Fa
     ID line 1 holds the channel label, ID line 2 ``mutext speed_hz=...
     input_name=... output_name=...`` (read back by :func:`read_uff58`).
     Directions: ``x`` is +1, ``y`` is +2.
+
+    Examples
+    --------
+    >>> import os, tempfile
+    >>> import numpy as np
+    >>> from mutext.response import FRF
+    >>> from mutext.uff import read_uff58, write_uff58
+    >>> h = FRF(np.array([10.0, 20.0]), np.array([1e-3, 2e-3 + 1e-3j]), input_station=1, output_station=3)
+    >>> with tempfile.TemporaryDirectory() as d:
+    ...     back = read_uff58(write_uff58(os.path.join(d, "h.uff"), [h]))
+    >>> len(back), back[0].label, bool(np.allclose(back[0].response, h.response))
+    (1, 'F1->x3', True)
     """
     import pyuff
     path = Path(path)

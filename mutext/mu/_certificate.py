@@ -27,6 +27,15 @@ def scaled_sigma(M, structure: BlockStructure, d) -> float:
         Its block structure.
     d : (len(structure),) array_like
         One positive scaling per block.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from mutext.mu import Block, BlockStructure, scaled_sigma
+    >>> M = np.array([[0.5, 2.0], [0.0, 0.5]])       # mu = 0.5 for two scalar blocks
+    >>> S = BlockStructure([Block.scalar(), Block.scalar()])
+    >>> round(scaled_sigma(M, S, [1.0, 1.0]), 4), round(scaled_sigma(M, S, [1.0, 100.0]), 4)
+    (2.118, 0.5101)
     """
     structure = _as_structure(structure)
     d = np.asarray(d, dtype=float)

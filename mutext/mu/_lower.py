@@ -385,6 +385,15 @@ def mu_lower(M, structure: BlockStructure, *, rng=0, scalings=None) -> MuLower:
         (``residual``, the smallest singular value of :math:`I - M\Delta`, is
         at rounding level) and :math:`\bar\sigma(\Delta) = 1/\text{value}`;
         ``value`` is recomputed from ``Delta``.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from mutext.mu import Block, BlockStructure, mu_lower
+    >>> M = np.array([[0.5, 2.0], [0.0, 0.5]])       # det(I - M Delta) = (1 - d1/2)(1 - d2/2): mu = 0.5
+    >>> r = mu_lower(M, BlockStructure([Block.scalar(), Block.scalar()]))
+    >>> round(r.value, 6)
+    0.5
     """
     structure = _as_structure(structure)
     M = structure.check(M)

@@ -246,6 +246,15 @@ def modes(model, *, speed: float | None = None, values=None, n: int | None = Non
         (see the module docstring).  Overdamped roots are dropped too.
     matrices : Matrices, optional
         Precomputed ``model.matrices(values)``.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from mutext.rotor import data_path, load_model
+    >>> from mutext.rotor.analysis import modes
+    >>> md = modes(load_model(data_path("three_mass.toml")))
+    >>> np.round(md.frequencies_hz, 3)                   # Hz, damped
+    array([0.952, 3.12 , 4.919])
     """
     n = _check_n(n)
     _no_impedance(model, "modes")
@@ -558,6 +567,14 @@ def state_space(model, *, inputs: Sequence[str] | None = None, outputs: Sequence
     values : mapping or array_like, optional
         Parameter values: a mapping ``name -> value`` (SI) overriding nominal ones, or a full
         vector in the order of ``parameters`` (default: nominal, see :meth:`Structure.values`).
+
+    Examples
+    --------
+    >>> from mutext.rotor import data_path, load_model
+    >>> from mutext.rotor.analysis import state_space
+    >>> G = state_space(load_model(data_path("three_mass.toml")), inputs=["f1"], outputs=["x1"])
+    >>> G.nstates, G.input_labels, G.output_labels
+    (6, ['f1'], ['x1'])
     """
     speed = _speed(model, speed)
     ins, outs = _ports(model, inputs, outputs)
