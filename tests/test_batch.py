@@ -12,7 +12,8 @@ from mutext.errors import ModelError
 @pytest.fixture(scope="module")
 def cases(tmp_path_factory):
     root = tmp_path_factory.mktemp("class")
-    assert main(["rig", "hide", "--seed", "10", "--count", "4", "--out", str(root)]) == 0
+    # three sets: two diagnosed by two worker processes, one broken below
+    assert main(["rig", "hide", "--seed", "10", "--count", "3", "--out", str(root)]) == 0
     return root
 
 
@@ -21,9 +22,9 @@ def test_batch_diagnoses_every_set_and_reports_a_broken_one(cases, capsys):
     capsys.readouterr()
     assert main(["diagnose", "--batch", str(cases), "--jobs", "2", "--quiet"]) == 0
     out = capsys.readouterr().out
-    assert "3 of 4 diagnosed, 1 failed; right in 3 of 3 with an answer key" in out
+    assert "2 of 3 diagnosed, 1 failed; right in 2 of 2 with an answer key" in out
     rows = list(csv.DictReader(open(cases / "summary.csv", encoding="utf-8")))
-    assert [r["status"] for r in rows] == ["ok", "ok", "failed", "ok"]
+    assert [r["status"] for r in rows] == ["ok", "ok", "failed"]
     bad = rows[2]
     assert "case_12/measured/in1_out1.csv" in bad["error"] and "FRFFileError" in bad["error"]
     for r in rows:
