@@ -348,3 +348,19 @@ def test_modes_of_a_model_with_an_impedance_are_refused_by_name():
     ext = loads_model(_with_impedance([1.0, 10.0], [1.0, 5.0]))
     with pytest.raises(ModelError, match="impedance element 'K_test'"):
         ext.natural_frequencies()
+
+
+def test_impedance_in_an_inch_pound_file_is_a_stiffness_in_lbf_per_inch():
+    # K(s) = 2 lbf/in (a constant): 2 * 4.4482216152605 N / 0.0254 m, the exact definitions
+    text = ('units = "inch-pound"\n[[mass]]\nname = "m1"\nmass = 10.0\n[[spring]]\nname = "k1"\nstiffness = 50.0\n'
+            'between = ["m1", "ground"]\n[[impedance]]\nname = "K"\nmass = "m1"\nnumerator = [2.0]\n'
+            'denominator = [1.0]\n')
+    el = loads_model(text).element_by_name["K"]
+    assert el.response(np.array([3.0]))[0] == pytest.approx(2 * 4.4482216152605 / 0.0254, rel=1e-12)
+
+
+def test_impedance_belongs_to_a_lumped_chain():
+    from mutext.rotor.assembly import Structure
+    from mutext.rotor.lumped_elements import Impedance, Spring
+    with pytest.raises(ModelError, match="impedance element belongs to a lumped chain"):
+        Structure([Spring(1, k=1.0), Impedance(1, [1.0], [1.0, 1.0])], layout="plane", n_nodes=1)
