@@ -2,10 +2,13 @@
 
 Independent checks: the strip integrals of Papadopoulos and Dimarogonas
 evaluated by mpmath in the other order of integration (outer over the depth
-coordinate, inner over the strips whose local depth exceeds it), the limits
-for a shallow crack, the ratio c44/c55 quoted in the book, the one-compliance
-element written out here, and the thesis rotor's stiffness loss with the crack
-facing x (first mode pair at standstill).
+coordinate, inner over the strips whose local depth exceeds it), a table of
+the compliances from another implementation (c55, c44 and the coupling c45 at
+a/D = 0.1 ... 0.5, with the difference in c44 and c45 explained), the limits
+for a shallow crack, the ratio c44/c55 quoted in the book, the crack element
+in its own frame (no coupling), the one-compliance element written out here,
+and the thesis rotor's stiffness loss with the crack facing x (first mode pair
+at standstill).
 """
 import casadi as ca
 import mpmath as mp
@@ -66,6 +69,80 @@ def test_reference_values_of_c44():
     assert cr.crack_compliance_dimensionless(0.4, component=44) == pytest.approx(1.65513, rel=5e-6)
     # c55 is unchanged by the new keyword
     assert cr.crack_compliance_dimensionless(0.4, component="c55") == cr.crack_compliance_dimensionless(0.4)
+
+
+# Tabulated compliances of Papadopoulos and Dimarogonas's strip model against abar = a/R, from the
+# table PAPADOPOULOS.csv of the ROSS rotordynamics package (github.com/petrobras/ross, file
+# ross/faults/data/PAPADOPOULOS.csv, commit e22c2ad31c1b15ea967e2bab3318d79c6e997137; rows abar = 0.2,
+# 0.4, 0.6, 0.8, 1.0, i.e. a/D = 0.1 ... 0.5; columns c55, c44, c45, same normalisation as here:
+# c = (1 - nu^2) cbar / (E R^3)).  It is an implementation independent of this package (ROSS
+# reads the table for its Crack fault).  No table of the papers themselves was at hand; their
+# formulas are checked in addition by the mpmath quadrature above.
+ROSS_TABLE = {   # a/D: (c55, c44, c45)
+    0.1: (0.144614, 0.00474954, 0.0302734),
+    0.2: (0.72488, 0.0545213, 0.225899),
+    0.3: (1.8922, 0.247011, 0.761595),
+    0.4: (3.97355, 0.827564, 1.97266),
+    0.5: (7.79039, 2.63318, 4.75993),
+}
+
+
+def _strip_integral_mpmath(depth_ratio, integrand, half=True):
+    """int int integrand(xi, alpha) d(alpha) d(xi) over the crack (xi in (0, b) if half, else (-b, b))."""
+    with mp.workdps(15):
+        ab = mp.mpf(2 * depth_ratio)
+        b = mp.sqrt(1 - (1 - ab)**2)
+
+        def inner(xi):
+            depth = mp.sqrt(1 - xi**2) - (1 - ab)
+            return mp.quad(lambda al: integrand(xi, al), [0, depth])
+
+        return float(mp.quad(inner, [0, b] if half else [-b, 0, b]))
+
+
+def _F(which, xi, al):
+    h = 2 * mp.sqrt(1 - xi**2)
+    lam = mp.pi * al / (2 * h)
+    g = mp.sqrt(mp.tan(lam) / lam) / mp.cos(lam)
+    if which == 2:
+        return g * (mp.mpf("0.923") + mp.mpf("0.199") * (1 - mp.sin(lam))**4)
+    return g * (mp.mpf("0.752") + mp.mpf("2.02") * al / h + mp.mpf("0.37") * (1 - mp.sin(lam))**3)
+
+
+@pytest.mark.parametrize("depth_ratio", sorted(ROSS_TABLE))
+def test_compliances_against_the_tabulated_values(depth_ratio):
+    c55_tab, c44_tab, c45_tab = ROSS_TABLE[depth_ratio]
+    c55 = cr.crack_compliance_dimensionless(depth_ratio)
+    c44 = cr.crack_compliance_dimensionless(depth_ratio, component=44)
+    # c55 (the moment that opens the crack): the table, to its six digits
+    assert c55 == pytest.approx(c55_tab, rel=5e-6)
+    # c44: the table integrates over one half of the crack front, 0 <= xi <= b, the half in tension
+    # under M4 (a crack whose other half closes): exactly half the package's value, at every depth.
+    # The package's crack is open and linear (the rig's slot never closes), so both halves count: a
+    # gaping notch has the same energy for +M4 and -M4, quadratic in M4, K_I^2 integrated over the front.
+    assert c44 == pytest.approx(2 * c44_tab, rel=5e-6)
+    # the tabulated c45 is 64/pi times the cross term's integral over that half front (checked here by
+    # an independent quadrature); over the whole front the integrand, odd in xi (K_I under M4 ~ xi,
+    # under M5 even in xi), cancels: c45 = 0 for a straight front, the package's element has no
+    # coupling between the two bending planes of the crack frame
+    cross = lambda xi, al: xi * mp.sqrt(1 - xi**2) * al * _F(1, xi, al) * _F(2, xi, al)
+    assert 64 / np.pi * _strip_integral_mpmath(depth_ratio, cross) == pytest.approx(c45_tab, rel=1e-5)
+    full = 64 / np.pi * _strip_integral_mpmath(depth_ratio, cross, half=False)
+    assert abs(full) < 1e-12 * c45_tab
+
+
+def test_axial_bending_coupling_is_left_out_for_a_reason():
+    """c15 (axial force and the moment that opens the crack) is even along the front and does not vanish.
+
+    From K_I = (P1 / (pi R^2) F1 + 4 M5 sqrt(1 - xi^2) / (pi R^3) F2) sqrt(pi alpha), the cross term is
+    c15 = (1 - nu^2) / (E R^2) * 8/pi int int sqrt(1 - xi^2) alpha F1 F2 over the front: the table's
+    value (column c15, a/D = 0.2: 0.225987) agrees.  The lateral beam model carries no axial force
+    (one bearing locates the shaft axially, the other floats), so M5 sees c55 only: the rotation is
+    c55 M5 + c15 P1 with P1 = 0."""
+    cross = lambda xi, al: mp.sqrt(1 - xi**2) * al * _F(1, xi, al) * _F(2, xi, al)
+    c15 = 8 / np.pi * _strip_integral_mpmath(0.2, cross, half=False)
+    assert c15 == pytest.approx(0.225987, rel=1e-5)
+    assert c15 > 0.1 * cr.crack_compliance_dimensionless(0.2)
 
 
 @pytest.mark.parametrize("depth_ratio, ratio", [(0.1, 0.07), (0.2, 0.15), (0.3, 0.26), (0.4, 0.42), (0.5, 0.68)])
@@ -175,6 +252,32 @@ def test_two_plane_element_default_is_the_one_compliance_element():
     assert np.allclose(np.asarray(Ks(ang)), K, rtol=0, atol=1e-12 * scale)
 
 
+def test_assembled_crack_has_no_coupling_in_the_crack_frame():
+    """The default crack at an angle, seen in its own frame: symmetric, the plane of the normal with c55,
+    the plane of the edge with c44 (the one-plane rotor's crack facing x and facing y), no coupling."""
+    from mutext.rotor import Rotor
+    from mutext.rotor.shaft_element import T_XZ, T_YZ
+
+    def delta(planes, beta):
+        rotor = Rotor(_shafts() + [cr.Crack(3, 0.4, xi=0.3, orientation=beta)], planes=planes)
+        el = rotor.elements[-1]
+        fn = ca.Function("k", [rotor.p], [el.stiffness_matrix(rotor._ps.symbols, rotor.layout)])
+        return np.asarray(fn(rotor.values()).full())
+
+    beta = 0.9
+    K = delta(2, beta)
+    Txz, Tyz = np.asarray(ca.DM(T_XZ).full()), np.asarray(ca.DM(T_YZ).full())
+    P_xi = np.cos(beta) * Txz + np.sin(beta) * Tyz       # deflection and rotation along the normal
+    P_eta = -np.sin(beta) * Txz + np.cos(beta) * Tyz     # ... and along the edge
+    scale = np.abs(K).max()
+    assert np.allclose(K, K.T, rtol=0, atol=1e-12 * scale)
+    assert np.allclose(P_xi @ K @ P_eta.T, 0.0, rtol=0, atol=1e-12 * scale)
+    k_xi, k_eta = delta(1, 0.0), delta(1, np.pi / 2)     # plane x-z: facing x sees c55, facing y c44
+    assert np.allclose(P_xi @ K @ P_xi.T, k_xi, rtol=0, atol=1e-10 * scale)
+    assert np.allclose(P_eta @ K @ P_eta.T, k_eta, rtol=0, atol=1e-10 * scale)
+    assert np.abs(k_eta).max() > 0.1 * np.abs(k_xi).max()
+
+
 def test_directional_deltas_agree_with_the_open_crack_at_any_angle():
     from mutext.rotor import Rotor
     beta = 1.1
@@ -195,10 +298,14 @@ def test_perpendicular_flag_is_checked_and_read_from_a_model_file():
     m = loads_model(text + "\n[[crack]]\nstation = 15\ndepth_ratio = 0.4\nperpendicular = true\n",
                     source="rotor.toml + crack", base_dir=data_path(""))
     assert m.elements[-1].perpendicular is True
-    # the default is the one-compliance model the book and the exercises were computed with
-    m = loads_model(text + "\n[[crack]]\nstation = 15\ndepth_ratio = 0.4\n",
+    m = loads_model(text + "\n[[crack]]\nstation = 15\ndepth_ratio = 0.4\nperpendicular = false\n",
                     source="rotor.toml + crack", base_dir=data_path(""))
     assert m.elements[-1].perpendicular is False
+    # the default is the full model, both bending compliances, in a file as in the class
+    m = loads_model(text + "\n[[crack]]\nstation = 15\ndepth_ratio = 0.4\n",
+                    source="rotor.toml + crack", base_dir=data_path(""))
+    assert m.elements[-1].perpendicular is True
+    assert cr.Crack(3, 0.2).perpendicular is True
 
 
 # ----------------------------------------------------------------------------

@@ -241,8 +241,9 @@ def test_sweeps_differ_by_their_sidebands_not_by_noise():
     assert np.array_equal(f, g)
     assert ex06.size(f, h, fc, hw) > 20 * ex06.LOW_NOISE
     assert ex06.size(g, h0, fc, hw) < 5 * ex06.LOW_NOISE
-    # a baseline fitted to H itself would not tell them apart
-    assert ex06.size(g, h0, fc, hw, invert=False) > 0.5 * ex06.size(f, h, fc, hw, invert=False)
+    # a baseline fitted to H itself finds a "sideband" on the healthy rotor too, above the level the
+    # detector must see at the crack: H is not quadratic this near a resonance, 1/H is
+    assert ex06.size(g, h0, fc, hw, invert=False) > 20 * ex06.LOW_NOISE
 
 
 def test_candidates_formula():

@@ -171,8 +171,9 @@ def test_combination_responses_are_the_off_diagonal_htfs(mayes):
     away = [0, 2, 3]
     for k in (-2, -1, 1, 2):
         assert np.allclose(hb[k].H[0, 0, away], hr(k)[0, 0, away], rtol=1e-9, atol=0)
-    # at 25 Hz (2 f = 5 F) the window term changes H_-1 by tens of percent: the check can fail
-    assert abs(hb[-1].H[0, 0, 1] - hr(-1)[0, 0, 1]) > 0.1 * abs(hr(-1)[0, 0, 1])
+    # at 25 Hz (2 f = 5 F) the window term changes H_-1 by 7 % (the time integration below confirms
+    # it; it grows with the asymmetry c55 - c44: 29 % with c55 alone): the check can fail
+    assert abs(hb[-1].H[0, 0, 1] - hr(-1)[0, 0, 1]) > 0.05 * abs(hr(-1)[0, 0, 1])
     # a gaping notch varies at 2x only: no response at f +/- F, a clear one at f +/- 2 F
     gap = periodic_rotor(cracked("gaping"), inputs=["i12"], outputs=["x13"]).reduce(1000.0)
     g = analyzer_combination(gap, f[[0, 2]], (-1, 1, 2))
@@ -193,10 +194,12 @@ def test_combination_responses_agree_with_time_integration(mayes):
     for k in (-2, -1, 1, 2):
         a, b = hb[k].H[0, 0], td["H_orders"][k]
         assert np.all(np.abs(b - a) < 1e-3 * np.abs(a)), (k, np.abs(b - a) / np.abs(a))
-        assert np.all(np.abs(a) > 3e-4 * np.abs(td["H"]))      # not lost under the main line
-    # at 25 Hz (2 f = 5 F) the window term moves H_-1 by 29 % (phase 0.7): the integration confirms it
+        # not lost under the main line (the smallest, order 2 at 80 Hz, is 6e-5 of it: the 2x terms
+        # shrink with the asymmetry c55 - c44)
+        assert np.all(np.abs(a) > 3e-5 * np.abs(td["H"]))
+    # at 25 Hz (2 f = 5 F) the window term moves H_-1 by 7.3 % (phase 0.7): the integration confirms it
     hr = harmonic_response(red, f[1:2], harmonics=8)
-    assert abs(td["H_orders"][-1][1] - hr(-1)[0, 0, 0]) > 0.2 * abs(hr(-1)[0, 0, 0])
+    assert abs(td["H_orders"][-1][1] - hr(-1)[0, 0, 0]) > 0.05 * abs(hr(-1)[0, 0, 0])
 
 
 def test_measure_rotor_records_combination_channels(tmp_path):

@@ -50,16 +50,26 @@ In an assembled :class:`mutext.rotor.Rotor` the crack is the element
 :class:`Crack` (``Crack(station, depth_ratio, orientation=..., xi=...,
 perpendicular=...)``, or a ``[[crack]]`` table in a model file): it adds the
 cracked-minus-intact stiffness of the host shaft element in the crack frame,
-with the depth ratio as a model parameter.  With ``perpendicular=True``
-(``perpendicular = true`` in a model file) both planes of the crack frame
-bend, through :math:`c_{55}` and :math:`c_{44}`.  The default ``False`` drops
-:math:`c_{44}` and treats bending in the plane of the crack edge as healthy:
-the one-compliance model the book, the exercises and the shipped examples
-were computed with, reproduced exactly.  At the rig's depth
-(:math:`a/D = 0.4`) it understates the mean stiffness loss (by a factor of
-about 1.44 for the thesis rotor) and overstates the asymmetry (about
-1/0.56); making the full model the default is the next step, with the
-book's numbers and exercise ex06 recomputed.
+with the depth ratio as a model parameter.  By default
+(``perpendicular=True``) both planes of the crack frame bend: the plane of
+the crack normal through :math:`c_{55}`, the plane of the crack edge through
+:math:`c_{44}`, the full bending compliance of [PD87]_.  The remaining terms
+of the crack's compliance matrix do not enter: the bending-bending coupling
+:math:`c_{45}` vanishes for a straight crack front, whose
+stress-intensity factor under :math:`M_4` is odd along the edge and under
+:math:`M_5` even (see :func:`crack_compliance_dimensionless`); the
+axial-bending coupling :math:`c_{15}` needs an axial force, which the
+lateral beam model neither carries nor constrains (it changes the bending
+compliance only where the shaft is held axially at both ends); the shear
+and torsion terms are left out (the crack's shear compliance is small
+beside the bending one of a slender shaft, and torsion is not modelled).
+``perpendicular=False`` (``perpendicular = false`` in a model file) is the
+one-compliance (hinge) model of the older literature: it drops
+:math:`c_{44}` and treats bending in the plane of the crack edge as healthy.
+At the rig's depth (:math:`a/D = 0.4`, :math:`c_{44}/c_{55} = 0.42`) it
+gives the thesis rotor's first mode pair (crack facing :math:`x`, at
+standstill) a mean stiffness loss 1/1.44 of the full model's and a
+twice-per-revolution asymmetry 1/0.56 of it.
 
 **Breathing crack (time domain).**  A crack that opens and closes with the
 shaft rotation (weight dominance) is modelled by a stiffness that varies
@@ -309,6 +319,16 @@ def crack_compliance_dimensionless(depth_ratio, *, n_quad: int = 16, component=5
     little of it far from the neutral axis of :math:`M_4`, so for shallow
     cracks :math:`\bar c_{55} \propto \bar a^{5/2}` but
     :math:`\bar c_{44} \propto \bar a^{7/2}`.
+
+    The coupling :math:`c_{45}` of the two moments vanishes: under
+    :math:`M_4` the stress-intensity factor is odd in :math:`\bar\xi`, under
+    :math:`M_5` even, so the cross term of :math:`K_I^2` cancels over the
+    straight front.  Tables that integrate over one half of the front only
+    (:math:`0 \le \bar\xi \le \bar b`, the half in tension under
+    :math:`M_4`, as for a crack whose other half closes) list a non-zero
+    :math:`c_{45}` and half the :math:`c_{44}` given here; the open crack
+    here is linear, a notch whose faces do not touch, and counts the whole
+    front (``tests/test_crack_compliance.py`` compares both).
 
     The double integral is evaluated by a fixed tensor Gauss-Legendre rule
     (``n_quad`` x ``n_quad`` points) after the substitutions
@@ -1118,7 +1138,7 @@ def _make_crack_class():
         with the shaft.  In the one-plane (x-z) layout the change is
         :math:`\cos^2\beta\,\Delta_\xi + \sin^2\beta\,\Delta_\eta` (or the
         mean).  With ``perpendicular=False``, :math:`\Delta_\eta = 0` (the
-        one-compliance model used before :math:`c_{44}` was added).
+        one-compliance model).
 
         Parameters
         ----------
@@ -1135,13 +1155,14 @@ def _make_crack_class():
             Gauss points of the compliance integrals.
         perpendicular : bool
             Include the compliance :math:`c_{44}` for the moment perpendicular
-            to the crack edge.  The default ``False`` keeps only
-            :math:`c_{55}` and treats bending in the plane of the crack edge as
-            healthy: the model the book's numbers, the exercises and the
-            shipped examples were computed with.  It under-estimates the mean
-            stiffness loss and over-estimates the asymmetry of a deep crack
-            (:math:`c_{44}/c_{55} \approx 0.42` at a/D = 0.4: mean loss x1.44,
-            asymmetry x0.56 for the thesis rotor's crack with ``True``).
+            to the crack edge (default ``True``: both bending compliances of
+            the crack, [PD87]_).  ``False`` keeps only :math:`c_{55}` and
+            treats bending in the plane of the crack edge as healthy: the
+            one-compliance (hinge) model of the older literature.  It
+            under-estimates the mean stiffness loss and over-estimates the
+            asymmetry of a deep crack (:math:`c_{44}/c_{55} \approx 0.42` at
+            a/D = 0.4: for the thesis rotor's crack the mean loss of the first
+            mode pair is x1.44 and its asymmetry x0.56 with ``True``).
         breathing : {None, "gaping", "mayes", "gasch"}
             A crack that turns with the shaft (see :mod:`mutext.rotor.periodic`):
             ``orientation`` is then the angle of the crack normal from :math:`x`
@@ -1167,7 +1188,7 @@ def _make_crack_class():
         FIELDS = {"depth_ratio": ("1", "crack depth over shaft diameter a/D")}
 
         def __init__(self, station: int, depth_ratio, *, orientation=0.0, xi: float = 0.0,
-                     n_quad: int = 16, perpendicular: bool = False, breathing: str | None = None,
+                     n_quad: int = 16, perpendicular: bool = True, breathing: str | None = None,
                      name: str | None = None):
             Element.__init__(self, (station, station + 1), name, depth_ratio=depth_ratio)
             if breathing is not None:

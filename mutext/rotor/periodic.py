@@ -768,7 +768,10 @@ def stepped_sine(model, freqs_hz, *, in_port: str | None = None, out_port: str |
     if not (np.isfinite(amplitude) and amplitude > 0):
         raise ModelError(f"amplitude must be positive, got {amplitude!r}")
     t_s, _ = _settle(pr, settle_s, revolutions)
-    w_max = float(np.sqrt(np.max(np.linalg.eigvalsh(pr.stiffness_harmonics(0)[0].real))))
+    # the stiffest state, not the revolution average: an open crack only removes stiffness (the
+    # breathing weights lie in [0, 1]), so the closed crack, K_healthy, bounds K(t) from above; with
+    # the mean, a switching (Gasch) crack with both compliances drives RK4 unstable while it is closed
+    w_max = float(np.sqrt(np.max(np.linalg.eigvalsh(pr.K_healthy))))
     if steps_per_rev is None:
         # RK4 is stable for h w < 2.8 on the imaginary axis: the stiffest Ritz shape sets the step;
         # the swept response itself gets at least 40 steps per period
