@@ -66,6 +66,8 @@ Rotor files
     [[crack]]                     # needs mutext.rotor.crack
     station = 15
     depth_ratio = 0.4
+    perpendicular = true          # optional, default true: both bending compliances (c55, c44);
+                                  # false: c55 only, the one-compliance (hinge) model
     breathing = "mayes"           # optional: the crack turns with the shaft; orientation = its angle
                                   # at t = 0 [rad].  "gaping" (also "open", "notch"): always open,
                                   # stiffness varying at 2x only (a slot whose faces never touch);
