@@ -364,3 +364,27 @@ def test_impedance_belongs_to_a_lumped_chain():
     from mutext.rotor.lumped_elements import Impedance, Spring
     with pytest.raises(ModelError, match="impedance element belongs to a lumped chain"):
         Structure([Spring(1, k=1.0), Impedance(1, [1.0], [1.0, 1.0])], layout="plane", n_nodes=1)
+
+
+def test_diagnosis_receptance_holds_the_impedance_and_tune_refuses_it(tmp_path):
+    # a model extended by model-based identification is diagnosed again: the screen's receptance must
+    # include K(jw) (checked against python-control's feedback loop), and tune(), which fits M, C, K
+    # alone, must say so instead of leaving the element out
+    import control as ct
+    from mutext.diagnose._screen import _Receptance
+    from mutext.rotor.tuning import tune
+    num, den = [1.0, 60.0, 7000.0], [1.0, 6.0, 350.0]
+    ext = loads_model(_with_impedance(num, den))
+    f = np.linspace(0.3, 6.0, 40)
+    rec = _Receptance(ext, ext.values(), 0.0, 2 * np.pi * f)
+    plant = loads_model(_three_mass_text() + '\n[[force]]\nname = "u_K"\nmass = "m2"\n[[sensor]]\nname = "y_K"\n'
+                        'mass = "m2"\n').state_space(inputs=["f1", "u_K"], outputs=["x1", "x3", "y_K"])
+    Kblk = ct.ss(ct.tf([[[0.0], [0.0], [0.0]], [[0.0], [0.0], num]],
+                       [[[1.0], [1.0], [1.0]], [[1.0], [1.0], den]]))
+    ref = ct.feedback(plant, Kblk, sign=-1).frequency_response(2 * np.pi * f).frdata[:2, 0, :]
+    b = rec.input_vector(("port", ext.input_names.index("f1")))
+    H = np.einsum("kij,j->ik", rec.R, b)[[0, 2]]          # x1, x3: DOFs 0 and 2 of the chain
+    assert np.max(np.abs(H - ref) / np.abs(ref)) < 1e-9
+    frf = ext.frf(f, inputs=["f1"], outputs=["x1"]).channel("x1", "f1")
+    with pytest.raises(ModelError, match="impedance element 'K_test'"):
+        tune(ext, [frf], ["k1"])

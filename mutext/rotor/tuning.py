@@ -292,6 +292,11 @@ def tune(model, frfs, parameters, bounds: Mapping | None = None, *, start: Mappi
     from .analysis import blas_single_thread
     t_build = time.perf_counter()
     model = _as_model(model)
+    from .lumped_elements import impedances
+    if impedances(model):
+        # the fitted responses are built from M, C, K; K(s) of the element would be left out silently
+        raise ModelError(f"tune: {model.name} holds the impedance element '{impedances(model)[0].name}' "
+                         "(a rational K(s), not part of M, C, K); tune the model without it")
     frfs = [frfs] if isinstance(frfs, FRF) else list(frfs)
     if not frfs:
         raise ModelError("tune: no FRFs given")
