@@ -1,0 +1,353 @@
+r""":func:`identify`: the identification as a whole (a measured FRF or an uncertain model as the
+true system, the first :math:`W_z` above the floor, the search, the reading of ``K``) and its
+result."""
+from __future__ import annotations
+
+import time
+from collections.abc import Callable
+from dataclasses import dataclass, field
+
+import control as ct
+import numpy as np
+
+from ..errors import ModelError
+from ..lti import as_ss, freqresp
+from ..response import FRF
+from ._floor import WzFloor, spread_weight, wz_floor
+from ._impedance import ImpedanceFit, fit_impedance, identifiable_band
+from ._measured import _measured_notes, _true_from_measured
+from ._plant import MBIPlant, controlled_engineering, mbi_plant
+from ._search import _best_try, _first_wz, _open_loop_difference, _search_grid, _search_notes, _search_wz, _WzSearch
+
+
+@dataclass
+class MBIResult:
+    r"""Result of :func:`identify`.
+
+    Attributes
+    ----------
+    K : control.StateSpace
+        The identified dynamics (force per displacement, applied as :math:`-u`):
+        :math:`K \approx D_u`.
+    Wz : float
+        The accepted error bound (output unit).
+    mu_upper, mu_lower : float
+        Certified robust-performance bounds of the final controller at ``Wz``.
+    tries : list of WzTry
+        Every W_z tried, in order.
+    plant : MBIPlant
+        The plant at the accepted ``Wz``.
+    fit : ImpedanceFit
+        Mass-damper-spring reading of ``K`` on its identifiable band.
+    controlled : control.StateSpace
+        The engineering model with ``K`` attached.
+    dk : mutext.dk.DKResult
+        The final D-K run.
+    seconds : float
+    notes : list of str
+    floor : WzFloor
+        The certified lower bound on any achievable ``Wz`` (:func:`wz_floor`).
+    measured_fit : mutext.frfit.RationalFit or None
+        When the true system was a measured FRF: the rational model that stood in
+        for it, with its residual.
+    omega : ndarray
+        The frequency grid (rad/s) of the search.
+    """
+    K: ct.StateSpace
+    Wz: float
+    mu_upper: float
+    mu_lower: float
+    tries: list
+    plant: MBIPlant
+    fit: ImpedanceFit
+    controlled: ct.StateSpace
+    dk: object
+    seconds: float
+    omega: np.ndarray = field(repr=False, default=None)
+    notes: list = field(default_factory=list)
+    floor: WzFloor | None = None
+    measured_fit: object = None
+
+    def bound(self, omega=None) -> np.ndarray:
+        r"""The certified error bound at ``omega`` (default: the search grid): ``Wz``, or
+        :math:`W_z|S(j\omega)|` with a shaped bound (``weight="spread"``).
+
+        Parameters
+        ----------
+        omega : array_like, optional
+            Frequencies in rad/s (default: the search grid ``omega``).
+        """
+        return self.plant.bound(self.omega if omega is None else omega)
+
+    def error(self, true_system, omega=None) -> np.ndarray:
+        """|x_true - x_controlled| (output unit per input unit) of a true system over ``omega``.
+
+        Parameters
+        ----------
+        true_system : control.StateSpace
+            A true system with the ports ``excitation`` and ``measurement``.
+        omega : array_like, optional
+            Frequencies in rad/s (default: the search grid ``omega``).
+        """
+        omega = self.omega if omega is None else np.asarray(omega, float)
+        pr = self.plant.ports
+        T = as_ss(true_system)
+        i = list(T.input_labels).index(pr["excitation"])
+        o = list(T.output_labels).index(pr["measurement"])
+        return np.abs(freqresp(T, omega)[o, i] - freqresp(self.controlled, omega)[0, 0])
+
+
+def identify(true, engineering, *, excitation: str, measurement: str, control_input: str,
+             control_output: str, Ww: float = 1.0, Wz: float | None = None, tol: float = 0.05,
+             max_tries: int = 8, regularization: float | None = 1e-4, omega=None,
+             dk_options: dict | None = None, out=None, time_limit: float | None = None,
+             max_fit_residual: float = 0.2, progress: Callable[[str, float], None] | None = None,
+             real: bool = False, branch: bool = False, weight: str = "flat") -> MBIResult:
+    r"""Identify the unmodeled dynamics of ``engineering`` by mu-synthesis (thesis sec. 3.5).
+
+    Runs D-K iteration on the plant of :func:`mbi_plant` and tunes :math:`W_z`
+    by the thesis's step-7 rule, automated: :math:`\mu > 1` means the bound is
+    too tight (raise :math:`W_z`), :math:`\mu < 1 - \text{tol}` too loose (lower
+    it).  Each new value comes from the log-log secant through the last two tries
+    (:math:`\mu` scales roughly like :math:`W_z^{-1}`), kept inside the bracket
+    once one is known.  Accepted: :math:`1 - \text{tol} \le \mu \le 1`.  No try goes
+    below the floor of :func:`wz_floor`, under which :math:`\mu > 1` for every
+    controller.
+
+    Parameters
+    ----------
+    true : control.StateSpace, mutext.uncertain.UncertainModel or mutext.rig.FRF
+        As in :func:`mbi_plant`, or a measured FRF from the excitation to the
+        measurement (SI units), which :func:`true_from_frf` fits by a stable
+        rational model; the grid is then the measured frequencies.
+    engineering, excitation, measurement, control_input, control_output, Ww, regularization
+        As in :func:`mbi_plant`.
+    Wz : float, optional
+        First value to try (default: 1 % of the peak open-loop error
+        :math:`W_w|x_t - x_e|`, or 1.1 times the floor if that is larger; a
+        value at or below the floor is raised to it, with a note).
+    tol : float
+        Accepted distance of mu below 1.
+    max_tries : int
+        Largest number of D-K runs.
+    omega : array_like, optional
+        Frequency grid (rad/s) for the D steps, the identifiable band and the fit.
+    dk_options : dict, optional
+        Passed to :func:`mutext.dk.dk_iteration` (or :func:`mutext.dk.dgk_iteration`).
+    out : file or None
+        A log of the search (one line per try, and the D-K tables); default
+        None: silent.
+    progress : callable(stage: str, fraction: float), optional
+        Called during the W_z search (e.g. :class:`mutext.progress.ProgressLine`):
+        the D-K stage of each try (passed on to :func:`mutext.dk.dk_iteration`
+        unless ``dk_options`` gives its own ``progress``) and the try's
+        :math:`W_z`, with the fraction of ``max_tries`` spent; the fraction
+        reaches 1 at the end.
+    time_limit : float, optional
+        Budget in seconds: no new D-K run is started once it is spent (a run
+        under way is finished).  The notes of the result report the budget and
+        what was used.
+    max_fit_residual : float
+        For a measured FRF: largest RMS relative residual of its rational fit
+        (:func:`true_from_frf`) for which identification goes on.
+    real : bool
+        Design each try's controller with the uncertain parameters kept real
+        (:func:`mutext.dk.dgk_iteration`) instead of plain D-K.  On trial 5
+        (10 % uncertainty) it accepts the same :math:`W_z` (4.86 mm), in seven
+        times the time: there D-K keeps its first, H-infinity, loop, whose
+        D-G bound the later iterations only raise.
+    branch : bool
+        Judge each try whose D-G bound could decide it (above ``1 - tol``) by
+        branch and bound on the real parameters (:func:`mutext.dk.branch_mu`),
+        a certified bound that closes the D-G bound's gap to :math:`\mu` where
+        the ranges are wide.  On trial 5 (10 % uncertainty) the search then
+        accepts 4.72 mm at :math:`\mu` = 0.993, where the D-G bound reads 1.003
+        (against 4.86 mm judged by D-G): it can accept values the D-G bound
+        rejects.  Each judged try costs some seconds more.
+    weight : {"flat", "spread"}
+        The frequency shape of the error bound.  ``"flat"`` (the thesis's):
+        the error may reach :math:`W_z` at every frequency.  ``"spread"``: the
+        bound :math:`W_z|S(j\omega)|` follows the spread of the true systems
+        (:func:`spread_weight`; needs an uncertain true model), so that ``K``
+        is held wherever the true set is narrow, not only where it is widest.
+        With wide uncertainty this is what lets ``K`` be read: on trial 5
+        (10 %) a flat bound holds ``K`` on 4.5-7.1 rad/s only (the spring read
+        to +/-85 N/m), the shaped one over 0.5-32 rad/s (+/-5 N/m).  :math:`W_z` is then the bound
+        at the widest spread, and the floor is the floor of the shaped bound.
+
+    Raises
+    ------
+    ModelError
+        ``max_tries`` not a positive integer, ``time_limit`` not positive,
+        a measured FRF that cannot be fitted (see :func:`true_from_frf`), no
+        frequency overlap, a bad grid.
+
+    Returns
+    -------
+    MBIResult
+        If no try reached the accepted window, the best try with mu <= 1 (or the
+        lowest mu) is returned with a note saying so.
+
+    Examples
+    --------
+    Trial 1a of the thesis: the engineering model's spring ``k3`` is 200 N/m,
+    the rig's 386 N/m.  One D-K run (a few seconds) finds the difference:
+
+    >>> from mutext.examples import three_mass as tm
+    >>> from mutext.mbi import identify
+    >>> trial = tm.TRIALS["1a"]
+    >>> r = identify(**tm.mbi_arguments(trial), max_tries=1, dk_options={"max_iter": 1})
+    >>> round(r.fit.dk), trial.Du["dk"]                # the spring K stands for [N/m]
+    (186, 186.0)
+    >>> bool(r.mu_upper <= 1)                           # the error bound W_z is certified
+    True
+    """
+    t0 = time.perf_counter()
+    _check_search_arguments(max_tries, time_limit, tol, real, branch, weight, true)
+    say = _logger(out)
+    kw = dict(excitation=excitation, measurement=measurement, control_input=control_input,
+              control_output=control_output, Ww=Ww, regularization=regularization)
+    start = _start(true, engineering, kw, omega, Wz, weight, max_fit_residual, say)
+    search = _search_wz(start.plant_at, start.Wz, start.floor, start.omega, _dk_options(out, dk_options), tol,
+                        max_tries, time_limit, t0, say, progress, real, branch)
+    return _result(search, start, tol, max_tries, time_limit, t0, progress)
+
+
+@dataclass
+class _Start:
+    """Where the W_z search starts: the true system (a measured FRF's stand-in), the keyword
+    arguments of :func:`mbi_plant` but ``Wz``, the grid, the shape of the bound, the floor,
+    the first W_z and the notes so far."""
+    true: object
+    engineering: object
+    kw: dict
+    omega: np.ndarray
+    shape: object
+    floor: WzFloor
+    Wz: float
+    notes: list
+    measured: object = None
+    measured_fit: object = None
+
+    def plant_at(self, Wz: float) -> MBIPlant:
+        """The identification plant with the error bound ``Wz``."""
+        return mbi_plant(self.true, self.engineering, Wz=Wz, **self.kw)
+
+
+def _start(true, engineering, kw: dict, omega, Wz, weight: str, max_fit_residual, say) -> _Start:
+    """The search's grid, shape, floor and first W_z, from the true system (fitted first if measured)."""
+    excitation, measurement, Ww = kw["excitation"], kw["measurement"], kw["Ww"]
+    measured, measured_fit = None, None
+    if isinstance(true, FRF):
+        measured = true
+        true, measured_fit, omega = _true_from_measured(measured, engineering, omega, excitation, measurement,
+                                                        max_fit_residual, say)
+    probe = mbi_plant(true, engineering, Wz=1.0, **kw)
+    omega = _search_grid(probe, omega)
+    diff = _open_loop_difference(probe, omega, excitation, measurement, Ww)
+    shape = None
+    if weight == "spread":
+        shape = spread_weight(true, excitation=excitation, measurement=measurement, omega=omega)
+        say(f"error bound shaped by the spread of the true systems ({shape.order} poles; the cover is at most "
+            f"{np.exp(shape.error):.2f} times the spread)")
+    floor = wz_floor(true, excitation=excitation, measurement=measurement, Ww=Ww, omega=omega, shape=shape)
+    Wz, notes = _first_wz(Wz, diff, floor)
+    if shape is not None:
+        S = np.abs(shape(omega))
+        notes.append(f"error bound shaped by the spread of the true systems: W_z |S(jw)|, |S| from "
+                     f"{S.min():.3g} to {S.max():.3g} on the grid "
+                     f"(a cover of the spread, at most {np.exp(shape.error):.2f} times it)")
+    if floor.value > 0:
+        say(f"W_z floor {floor.value:.4g} (spread of {floor.samples} true systems at {floor.omega:.4g} rad/s)")
+    return _Start(true, engineering, {**kw, "Wz_shape": shape}, omega, shape, floor, Wz, notes, measured,
+                  measured_fit)
+
+
+def _dk_options(out, dk_options) -> dict:
+    """The options of each try's D-K run: 4 iterations, the log on ``out``, then ``dk_options`` (checked)."""
+    opts = {"max_iter": 4, "out": None if out is None else out}
+    if dk_options is not None and not isinstance(dk_options, dict):
+        raise ModelError(f"dk_options must be a dict of dk_iteration's keyword arguments, got "
+                         f"{type(dk_options).__name__}")
+    import inspect
+
+    from ..dk import dgk_iteration, dk_iteration
+    # the options go to dk_iteration, or to dgk_iteration when real parameters are kept real
+    known = (set(inspect.signature(dk_iteration).parameters) | set(inspect.signature(dgk_iteration).parameters)) \
+        - {"P", "structure", "nmeas", "ncon"}
+    unknown = sorted(set(dk_options or {}) - known)
+    if unknown:
+        raise ModelError(f"dk_options: unknown option(s) {', '.join(map(repr, unknown))}; dk_iteration and "
+                         f"dgk_iteration take {', '.join(sorted(known))}")
+    opts.update(dk_options or {})
+    return opts
+
+
+def _result(search: _WzSearch, start: _Start, tol: float, max_tries: int, time_limit, t0: float,
+            progress) -> MBIResult:
+    """The result of the search's best try: its controller, read on its identifiable band, with the notes."""
+    best = _best_try(search.tries)
+    plant, res = search.runs[best]
+    notes = start.notes
+    if search.failed:
+        notes.append(f"the K step failed at {len(search.failed)} W_z value(s) ("
+                     + ", ".join(f"{w:.4g}" for w, _ in search.failed) + "); the search moved on to looser ones")
+    if start.measured_fit is not None:
+        notes += _measured_notes(plant, res, start.measured, start.measured_fit)
+    notes += _search_notes(search, best, tol, max_tries, time_limit, t0)
+    judged = [t for t in search.tries if t.mu_upper < t.mu_dg]
+    if judged:
+        notes.append(f"branch and bound on the real parameters judged {len(judged)} of {len(search.tries)} "
+                     f"tries below their D-G bound (accepted W_z: mu {search.tries[best].mu_upper:.4f}, "
+                     f"D-G {search.tries[best].mu_dg:.4f})")
+    if plant.eps_u or plant.eps_y:
+        notes.append(f"regularised: control penalty {plant.eps_u:.3g} per unit u, sensor noise "
+                     f"{plant.eps_y:.3g} (the thesis plant is singular)")
+    fit = _fit_on_identifiable_band(plant, res.K, start.omega, notes)
+    if progress is not None:
+        progress(f"W_z search done: W_z = {search.tries[best].Wz:.4g}, mu <= {search.tries[best].mu_upper:.4f}",
+                 1.0)
+    tries = search.tries
+    return MBIResult(res.K, tries[best].Wz, tries[best].mu_upper, tries[best].mu_lower, tries, plant, fit,
+                     controlled_engineering(plant, res.K), res, time.perf_counter() - t0, start.omega, notes,
+                     start.floor, start.measured_fit)
+
+
+def _logger(out):
+    """``say(text)``: a line ``[mbi] text`` on ``out`` (nothing for ``None``)."""
+    def say(text):
+        if out is not None:
+            print(f"[mbi] {text}", file=out, flush=True)
+    return say
+
+
+def _check_search_arguments(max_tries, time_limit, tol, real, branch, weight, true) -> None:
+    """The options of :func:`identify`'s search, checked (``true`` for ``weight="spread"``)."""
+    if isinstance(max_tries, (bool, np.bool_)) or not isinstance(max_tries, (int, np.integer)) or max_tries < 1:
+        raise ModelError(f"identify: max_tries must be a positive integer (the number of D-K runs allowed), "
+                         f"got {max_tries!r}")
+    if time_limit is not None and (isinstance(time_limit, (bool, np.bool_))
+                                   or not isinstance(time_limit, (int, float, np.integer, np.floating))
+                                   or not time_limit > 0):
+        raise ModelError(f"identify: time_limit must be a positive number of seconds or None, got {time_limit!r}")
+    if not (isinstance(tol, (int, float, np.integer, np.floating)) and 0 < tol < 1):
+        raise ModelError(f"identify: tol must lie in (0, 1), got {tol!r}")
+    if not isinstance(real, (bool, np.bool_)):
+        raise ModelError(f"identify: real must be True or False, got {real!r}")
+    if not isinstance(branch, (bool, np.bool_)):
+        raise ModelError(f"identify: branch must be True or False, got {branch!r}")
+    if weight not in ("flat", "spread"):
+        raise ModelError(f"identify: weight must be 'flat' or 'spread', got {weight!r}")
+    if weight == "spread" and isinstance(true, FRF):
+        raise ModelError("identify: weight='spread' follows the spread of an uncertain true model; a measured "
+                         "FRF has none (use weight='flat')")
+
+
+def _fit_on_identifiable_band(plant: MBIPlant, K, omega, notes: list) -> ImpedanceFit:
+    """The impedance fit of ``K`` on its identifiable band (the whole grid if that band is too thin)."""
+    sens, band = identifiable_band(plant, K, omega)
+    if band.sum() < 3:
+        notes.append("K has almost no identifiable band (|s K| >= 1 at fewer than 3 frequencies); "
+                     "the fit uses the whole grid")
+        band = np.ones_like(band)
+    return fit_impedance(K, omega[band], weight=sens[band])
