@@ -185,3 +185,21 @@ def test_an_unmodelled_absorber_is_localised_at_its_station(example, seed, tmp_p
     from mutext.report import write_diagnosis
     paths = write_diagnosis(d, tmp_path)
     assert any(p.endswith("impedance.png") for p in paths["figures"])
+
+
+def test_a_model_with_a_wrong_impedance_element_is_not_explained_by_a_global_effect(tmp_path):
+    """A model extended by model-based identification holds an [[impedance]] element (a rational K(s), not
+    part of M, C, K).  Diagnosed against data from the model without it, every hypothesis must carry the
+    element: a structure-wide hypothesis (frequency-axis or damping scale) that rebuilt the dynamic
+    stiffness from M, C, K alone dropped it and was read as 'explained' at a size of zero."""
+    from mutext.cli import main
+    assert main(["rig", "hide", "--example", "three_mass", "--kind", "none", "--seed", "0", "--out",
+                 str(tmp_path / "d")]) == 0
+    model = tmp_path / "d" / "model.toml"
+    model.write_text(model.read_text() + '\n[[impedance]]\nname = "K_extra"\nmass = "m2"\n'
+                     'numerator = [1.0, 60.0, 7000.0]\ndenominator = [1.0, 6.0, 350.0]\n')
+    measured = sorted(str(p) for p in (tmp_path / "d" / "measured").glob("*.csv"))
+    d = diagnose(str(model), measured)
+    assert d.status != "explained", d.report()
+    assert all(e.hypothesis.glob is None for e in d.effects), d.report()
+    assert d.localized["station"] == 2, d.localized["ranking"]

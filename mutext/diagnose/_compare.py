@@ -9,6 +9,7 @@ import numpy as np
 from ..errors import ModelError
 from ..frfit import resonances
 from ._result import ResonanceRow
+from .faults._base import model_poles
 
 log = logging.getLogger("mutext.diagnose")
 
@@ -19,10 +20,8 @@ def _errors(Hs, meas) -> dict:
 
 
 def _model_modes(model, speed):
-    md = model.modes(speed=speed)
-    f = np.abs(md.eigenvalues) / (2 * np.pi)        # undamped natural frequency, as the data's poles
-    z = np.asarray(md.damping_ratio, float)
-    return f, z
+    # undamped natural frequency, as the data's poles
+    return model_poles(model, speed)
 
 
 #: Smallest relative frequency difference the summary calls a mismatch: vector fitting of noisy data is

@@ -26,7 +26,7 @@ class _Receptance:
         # a rational impedance element (a model extended by model-based identification) is not in
         # M, C, K: its K(jw) joins the dynamic stiffness at its DOF, as in rotor.analysis.frf
         from ..rotor.lumped_elements import impedances
-        imp = [(el.dofs(model.layout)[0], el) for el in impedances(model)]
+        self.impedances = imp = [(el.dofs(model.layout)[0], el) for el in impedances(model)]
         R = np.empty((self.omega.size, n, n), complex)
         chunk = max(1, int(chunk_bytes // (16 * n * n)))
         for k0 in range(0, self.omega.size, chunk):

@@ -144,3 +144,36 @@ def local_change(h: Hypothesis, theta: float, w) -> np.ndarray:
         return np.broadcast_to(dK, (w.size,) + dK.shape).astype(complex)
     s = (np.ones_like(w), 1j * w, -w * w)[h.order]
     return (theta * s)[:, None, None] * h.pattern[None]
+
+
+def model_poles(model, speed: float = 0.0):
+    r"""Undamped natural frequencies [Hz] and damping ratios of the model's oscillating poles.
+
+    From :meth:`modes` (M, C, K) when it can; a model holding a rational
+    impedance element (a model extended by model-based identification) has
+    states outside M, C, K, and its poles come from the state space instead:
+    for each pole :math:`p` with :math:`\Im p > 0`, :math:`f = |p|/2\pi` and
+    :math:`\zeta = -\Re p/|p|`.
+
+    Parameters
+    ----------
+    model : mutext.rotor.assembly.Structure or Rotor
+        The engineering model.
+    speed : float, optional
+        Spin speed [rad/s] (rotors).
+
+    Returns
+    -------
+    f : ndarray
+        Undamped natural frequencies [Hz].
+    zeta : ndarray
+        Damping ratios.
+    """
+    from ...rotor.lumped_elements import impedances
+    if not impedances(model):
+        md = model.modes(speed=speed)
+        return np.abs(md.eigenvalues) / (2 * np.pi), np.asarray(md.damping_ratio, float)
+    p = np.linalg.eigvals(np.asarray(model.state_space().A, float))
+    p = p[p.imag > 0]
+    p = p[np.argsort(np.abs(p))]
+    return np.abs(p) / (2 * np.pi), -p.real / np.abs(p)

@@ -36,7 +36,7 @@ import math
 
 import numpy as np
 
-from ._base import Hypothesis, Param
+from ._base import Hypothesis, Param, model_poles
 
 KINDS = ("absorber",)
 
@@ -79,7 +79,7 @@ def candidates(model) -> list[Hypothesis]:
         return []
     M, C, K, _ = model.matrices()
     total = float(np.trace(M))
-    fn = np.asarray(model.natural_frequencies(), float)
+    fn = np.asarray(model_poles(model)[0], float)
     fn = fn[np.isfinite(fn) & (fn > 0)]
     lo, hi = (0.5 * fn.min(), 2.0 * fn.max()) if fn.size else (0.1, 1e3)
     tunes = 2 * np.pi * np.geomspace(lo, hi, 40)

@@ -28,7 +28,7 @@ from __future__ import annotations
 import numpy as np
 
 from ...rotor.elements import Spring
-from ._base import Hypothesis, Param
+from ._base import Hypothesis, Param, model_poles
 
 KINDS = ("pedestal",)
 
@@ -64,7 +64,7 @@ def candidates(model) -> list[Hypothesis]:
         return []
     M = model.matrices()[0]
     total = float(np.trace(M))
-    fn = np.asarray(model.natural_frequencies(), float)
+    fn = np.asarray(model_poles(model)[0], float)
     fn = fn[np.isfinite(fn) & (fn > 0)]
     lo, hi = (0.5 * fn.min(), 2.0 * fn.max()) if fn.size else (0.1, 1e3)
     wp = 2 * np.pi * np.geomspace(lo, hi, 120)       # fine: a lightly damped peak must be met closely

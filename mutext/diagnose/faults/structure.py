@@ -77,6 +77,8 @@ def responses(rec, data, hyps: list, thetas: list) -> list:
         idx = data.idx[ks[0]]
         w = rec.omega[idx] * (1 + eps)
         Z = rec.K[None] - (w * w)[:, None, None] * rec.M[None] + 1j * w[:, None, None] * ((1 + a) * rec.D)[None]
+        for dof, el in rec.impedances:      # a rational element of the model: K(jw) at the scaled axis too
+            Z[:, dof, dof] += el.response(w)
         for h, t in zip(hyps, thetas):
             if h.gain is not None or h.glob is not None:
                 continue
