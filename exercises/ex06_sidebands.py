@@ -27,7 +27,8 @@ The sweeps of (b) and (c) are those of the book's rig (chapter "The cracked
 rotor at speed"): force at station 12, displacement at station 13, 20-225 Hz
 in 0.5 Hz steps, shaft at 9 to 11 Hz (the speed is an argument), with relative noise: each
 measured value is ``H (1 + noise * n)`` with ``n`` circular complex Gaussian,
-``E|n|^2 = 1``.  Sidebands are a few tenths of a percent of the response.
+``E|n|^2 = 1``.  Sidebands are small: from about a tenth of a percent of the
+response (an always-open crack's) to a few percent (a deep breathing crack's).
 
 Rules
 -----
