@@ -359,3 +359,20 @@ def test_more_compliance_only_lowers_the_natural_frequencies(orientation):
     assert f_new[1] < f_old[1] * (1 - 1e-3) and f_new[3] < f_old[3] * (1 - 1e-3)
     if orientation == '"mean"':
         assert np.all(f_new < f_old * (1 - 1e-3))
+
+
+def test_diagnosis_crack_hypothesis_is_the_default_crack_of_a_model_file():
+    """The screen's crack at station 15 changes K exactly as the [[crack]] entry it writes (the
+    default crack: both compliances, facing x) changes the assembled rotor."""
+    from mutext.diagnose.faults.crack import candidates
+    healthy = _thesis_rotor()
+    (hyp,) = candidates(healthy, stations=[15])
+    dk = hyp.crack(0.4)
+    cracked = _thesis_rotor("\n[[crack]]\nstation = 15\ndepth_ratio = 0.4\n")
+    full = cracked.matrices(cracked.values())[2] - healthy.matrices(healthy.values())[2]
+    idx = np.asarray(hyp.dofs)
+    assert np.allclose(full[np.ix_(idx, idx)], dk, rtol=0, atol=1e-9 * np.abs(dk).max())
+    # ... including the plane along the crack edge (c44): not the one-compliance change
+    one = _thesis_rotor(_crack(False))
+    k_one = one.matrices(one.values())[2] - healthy.matrices(healthy.values())[2]
+    assert not np.allclose(k_one[np.ix_(idx, idx)], dk, rtol=0, atol=1e-3 * np.abs(dk).max())

@@ -8,8 +8,12 @@ kind              change of dynamic stiffness                             candid
 ================  ======================================================  =================================
 
 The change is built once per element as a CasADi function of the model's
-parameters and the depth ratio and evaluated at the model's values.  Written
-into the model file as a ``[[crack]]`` entry (station, depth ratio).
+parameters and the depth ratio and evaluated at the model's values.  The
+hypothesis is the package's default crack: open, facing :math:`x` (the
+measured direction), with both bending compliances (:math:`c_{55}` across
+the crack edge, :math:`c_{44}` along it).  Written into the model file as a
+``[[crack]]`` entry (station, depth ratio), which reads back as the same
+crack.
 """
 from __future__ import annotations
 
