@@ -280,6 +280,8 @@ def test_hinf_norm_true_axis_poles_found_in_stiff_systems(seed):
     assert 0 < hinf_norm(G1).value < np.inf
 
 
+# slow (11 CPU-s): the stiff loop's frequency response against mpmath stays in the default run
+@pytest.mark.slow
 def test_hinf_norm_stiff_closed_loop_matches_mpmath_peak():
     """slycot's controller on the near-axis plant: the response is flat and peaks at DC.
     Old code: inf (the -1e-6 poles flagged beside the 5.9e6 controller pole).  The

@@ -164,6 +164,9 @@ def test_wz_floor_spring_trial():
     assert wz_floor(tm.mechanical_model(tr.true), excitation="f1", measurement="x1").value == 0.0
 
 
+# slow (8 CPU-s): the floor itself is checked in the default run (test_wz_floor_spring_trial); that the
+# floor is a floor (mu > 1 below it) runs with the slow tests
+@pytest.mark.slow
 def test_below_the_floor_mu_exceeds_one():
     """Below the floor, the mu lower bound of the D-K controller (an independent computation:
     a destabilising perturbation found by power iteration) must exceed 1; the search starts above it."""
@@ -187,6 +190,8 @@ def test_below_the_floor_mu_exceeds_one():
     assert all(0.0 <= frac <= 1.0 for _, frac in calls)
 
 
+# slow (11 CPU-s): identify() in the default run: test_identify_from_a_measured_frf_file
+@pytest.mark.slow
 def test_identify_with_the_parameters_kept_real():
     """``real=True``: each W_z try is a D-G-K search (mutext.dk.dgk_iteration); the mu reported
     is the D-G bound of its best try, and the hidden spring is still read from K."""

@@ -113,6 +113,8 @@ def test_bad_level_and_size_are_named():
         branch_certifies(np.eye(3), S, 1.0)
 
 
+# slow (15 CPU-s): the branch bound against brute force runs in the default run on random matrices (below)
+@pytest.mark.slow
 def test_three_mass_loop_with_ten_percent_uncertainty():
     """Trial 5 of the three-mass rig at W_z = 5 mm with its D-K controller (tests/data): the
     D-G bound (AB13MD's too) reads about 1.045 near the first resonance, while mixed mu, by
