@@ -21,6 +21,29 @@ def real_scaled_plant(P, structure: BlockStructure, scale: float, nmeas: int, nc
     plant and a real block :math:`|\delta| \le 1` is the loop of ``P`` with
     :math:`|\delta| \le c`: the parameters' ranges shrunk by the factor
     :math:`c` = ``scale``, every other block unchanged.  No states are added.
+
+    Parameters
+    ----------
+    P : control.StateSpace
+        Generalized plant with inputs ``[w_Delta; u]`` and outputs
+        ``[z_Delta; y]``, the ``Delta`` channels following ``structure``.
+    structure : BlockStructure
+        The blocks; the output rows (``z_Delta``) of its real blocks are scaled.
+    scale : float
+        The factor :math:`c` on the real parameters' ranges, in (0, 1].
+    nmeas, ncon : int
+        Number of measurements (last outputs) and controls (last inputs).
+
+    Returns
+    -------
+    control.StateSpace
+        Same states, inputs and outputs (and labels) as ``P``.
+
+    Raises
+    ------
+    ModelError
+        Sizes of ``P`` and ``structure`` that do not match, ``scale`` outside
+        (0, 1].
     """
     P = as_ss(P, "P")
     if not isinstance(structure, BlockStructure):

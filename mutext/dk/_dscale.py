@@ -20,6 +20,25 @@ def fit_dscale(omega, mag, order: int, weight=None, iterations: int = 8) -> DSca
     The vector fit of :func:`mutext.frfit.fit_magnitude` (same parameters,
     result and errors), on :math:`|\hat D|^2` as a rational function of
     :math:`\omega^2`, made stable and minimum phase by spectral factorisation.
+
+    Parameters
+    ----------
+    omega : array_like
+        Positive frequencies [rad/s], shape ``(nw,)``.
+    mag : array_like
+        Positive magnitudes of the scaling at ``omega``, shape ``(nw,)``.
+    order : int
+        Order of :math:`\hat D`: 0 (a constant) to 5.
+    weight : array_like, optional
+        Positive weight of each frequency on the error of :math:`\log|\hat D|`,
+        shape ``(nw,)`` (default 1).
+    iterations : int
+        Largest number of vector-fitting pole relocations.
+
+    Returns
+    -------
+    DScaleFit
+        As :func:`mutext.frfit.fit_magnitude` returns it.
     """
     return fit_magnitude(omega, mag, order, weight=weight, iterations=iterations)
 
@@ -29,6 +48,31 @@ def fit_dscale_auto(omega, mag, weight=None, max_order: int = 4, tol: float = 0.
 
     If no order reaches ``tol``, the most accurate fit is returned; a higher
     order is preferred only if it lowers the error by at least 20 %.
+
+    Parameters
+    ----------
+    omega : array_like
+        Positive frequencies [rad/s], shape ``(nw,)``.
+    mag : array_like
+        Positive magnitudes of the scaling at ``omega``, shape ``(nw,)``.
+    weight : array_like, optional
+        Positive weight of each frequency on the error of the log magnitude,
+        shape ``(nw,)`` (default 1).
+    max_order : int
+        Highest order tried (at most 5).
+    tol : float
+        Accepted error of the fit: the largest weighted error of the log
+        magnitude (``DScaleFit.error``; 0.05 is about 5 % in magnitude).
+
+    Returns
+    -------
+    DScaleFit
+        The fit of the lowest order within ``tol``, or the most accurate one.
+
+    Raises
+    ------
+    SolverError
+        The fit failed at every order.
     """
     best = None
     for n in range(0, max_order + 1):

@@ -25,6 +25,20 @@ def near_axis_poles(P, gap: float = NEAR_AXIS_GAP) -> np.ndarray:
     separates the cluster): typically a weight that approximates an integrator
     by a pole at -1e-6 rad/s, or an exact integrator.  Poles in the open right
     half plane are never listed.
+
+    Parameters
+    ----------
+    P : control.StateSpace or control.TransferFunction
+        The plant (any number of inputs and outputs).
+    gap : float
+        Ratio of magnitudes that separates the cluster from the poles above it
+        (default :data:`NEAR_AXIS_GAP`, 1e-3: three decades).
+
+    Returns
+    -------
+    ndarray of complex
+        The poles of the cluster [rad/s] in the closed left half plane, by
+        increasing magnitude; empty when there is no such gap.
     """
     P = as_ss(P)
     if P.nstates == 0:

@@ -12,7 +12,34 @@ from ..lti import as_ss, balance_states, check_finite, ss
 
 @dataclass
 class PlantParts:
-    """The blocks of a generalized plant (all 2-D float arrays)."""
+    r"""The blocks of a generalized plant (all 2-D float arrays).
+
+    With ``n`` states, ``nw`` exogenous inputs ``w``, ``nu`` controls ``u``,
+    ``nz`` performance outputs ``z`` and ``ny`` measurements ``y``:
+    :math:`\dot x = Ax + B_1w + B_2u`, :math:`z = C_1x + D_{11}w + D_{12}u`,
+    :math:`y = C_2x + D_{21}w + D_{22}u`.
+
+    Attributes
+    ----------
+    A : ndarray, shape (n, n)
+        State matrix.
+    B1 : ndarray, shape (n, nw)
+        Input matrix of ``w``.
+    B2 : ndarray, shape (n, nu)
+        Input matrix of ``u``.
+    C1 : ndarray, shape (nz, n)
+        Output matrix of ``z``.
+    C2 : ndarray, shape (ny, n)
+        Output matrix of ``y``.
+    D11 : ndarray, shape (nz, nw)
+        Feedthrough from ``w`` to ``z``.
+    D12 : ndarray, shape (nz, nu)
+        Feedthrough from ``u`` to ``z``.
+    D21 : ndarray, shape (ny, nw)
+        Feedthrough from ``w`` to ``y``.
+    D22 : ndarray, shape (ny, nu)
+        Feedthrough from ``u`` to ``y``.
+    """
     A: np.ndarray
     B1: np.ndarray
     B2: np.ndarray
@@ -109,10 +136,36 @@ def _labels(P, kind):
 def check_plant(P, nmeas: int, ncon: int) -> tuple[ct.StateSpace, PlantParts, list[str]]:
     """Validate a generalized plant for H-infinity synthesis.
 
-    Returns ``(P, parts, notes)`` where ``notes`` lists properties that are
-    allowed but worth knowing (singular ``D12``/``D21``).  Raises
-    :class:`ModelError` for malformed input (sizes, non-finite entries) and
-    :class:`IllPosedError` when no stabilizing controller can exist.
+    Parameters
+    ----------
+    P : control.StateSpace or control.TransferFunction
+        Generalized plant with inputs ``[w; u]`` and outputs ``[z; y]``
+        (continuous time).
+    nmeas : int
+        Number of measurements ``y`` (the last outputs of ``P``; at least 1,
+        fewer than the outputs).
+    ncon : int
+        Number of control inputs ``u`` (the last inputs of ``P``; at least 1,
+        fewer than the inputs).
+
+    Returns
+    -------
+    P : control.StateSpace
+        The plant as a state space.
+    parts : PlantParts
+        Its blocks.
+    notes : list of str
+        Properties that are allowed but worth knowing (singular ``D12`` or
+        ``D21``, rank loss of the plant's pencils on the imaginary axis).
+
+    Raises
+    ------
+    ModelError
+        Malformed input: port counts, non-finite entries, a control input or
+        measurement that is not connected.
+    IllPosedError
+        No stabilizing controller can exist (``(A, B2)`` not stabilizable or
+        ``(C2, A)`` not detectable).
     """
     for name, v in (("nmeas", nmeas), ("ncon", ncon)):
         if isinstance(v, (bool, np.bool_)) or not isinstance(v, (int, np.integer)) or v < 1:

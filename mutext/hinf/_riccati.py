@@ -107,6 +107,18 @@ def riccati_feasible(p: PlantParts, g: float) -> bool:
     Riccati solution :math:`X_\infty \succeq 0`; (iii) likewise
     :math:`Y_\infty \succeq 0` for :math:`J_\infty`; (iv)
     :math:`\rho(X_\infty Y_\infty) < g^2`.
+
+    Parameters
+    ----------
+    p : PlantParts
+        The blocks of the generalized plant (:func:`check_plant`).
+    g : float
+        The level tested (> 0; the closed-loop H-infinity norm to stay below).
+
+    Returns
+    -------
+    bool
+        True when the four conditions hold at ``g``.
     """
     return _riccati_solutions(p, g)[2] == ""
 

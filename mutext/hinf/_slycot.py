@@ -15,14 +15,25 @@ from ..lti import as_ss, hinf_norm, lft_lower, ss, stability
 
 
 def slycot_hinf_norm(sys) -> float:
-    """H-infinity norm by SLICOT AB13DD (through slycot), used as an independent check.
+    r"""H-infinity norm by SLICOT AB13DD (through slycot), used as an independent check.
 
     AB13DD is asked to equilibrate the system first (``EQUIL='S'``, as
     python-control's ``linfnorm`` does): without it, on the flat closed loops of
     near-optimal controllers of badly scaled plants, it overestimated the norm
     by up to 1.3e-3 relative, where a direct complex solve at its own peak
-    frequency agreed with our value to 1e-7.  Returns ``nan`` when slycot is not
-    available or fails.
+    frequency agreed with our value to 1e-7.
+
+    Parameters
+    ----------
+    sys : control.StateSpace or control.TransferFunction
+        Continuous-time, stable system (any number of inputs and outputs).
+
+    Returns
+    -------
+    float
+        :math:`\|G\|_\infty` (the peak of the largest singular value over
+        frequency); the 2-norm of ``D`` for a static system; ``nan`` when slycot
+        is not available or fails.
     """
     sys = as_ss(sys)
     try:
@@ -49,6 +60,24 @@ class SlycotReference:
     loop and achieves the claimed level to ``rtol``), ``'unverified'`` (it
     returned, but the claim does not hold: see ``note``), ``'error'`` (it
     refused the problem) or ``'timeout'``.
+
+    Attributes
+    ----------
+    status : {"verified", "unverified", "error", "timeout"}
+        The verdict (see above).
+    gamma : float
+        The level slycot claims for its controller (``nan`` on error or timeout).
+    K : control.StateSpace or None
+        Its controller (``nmeas`` inputs, ``ncon`` outputs); None on error or timeout.
+    achieved : float
+        The closed-loop H-infinity norm the controller achieves, recomputed by
+        :func:`mutext.lti.hinf_norm` on the loop rebuilt from the plant (``inf``
+        for an unstable loop, ``nan`` when not computed).
+    note : str
+        Why the result is not verified (slycot's error, the unstable pole, the
+        claimed and achieved levels); empty when verified.
+    seconds : float
+        Time slycot took [s] (wall clock).
     """
     status: str
     gamma: float = float("nan")
@@ -86,6 +115,27 @@ def slycot_hinfsyn(P, nmeas: int, ncon: int, timeout: float | None = 20.0,
     after ``10 * timeout + 60`` seconds of wall-clock time).  Its controller is
     then checked the same way ours is: closed loop rebuilt from ``P`` and
     ``K``, stability, norm recomputed by :func:`mutext.lti.hinf_norm`.
+
+    Parameters
+    ----------
+    P : control.StateSpace
+        Generalized plant with inputs ``[w; u]`` and outputs ``[z; y]``
+        (continuous time).
+    nmeas : int
+        Number of measurements ``y`` (the last outputs of ``P``).
+    ncon : int
+        Number of control inputs ``u`` (the last inputs of ``P``).
+    timeout : float or None
+        CPU time [s] the child process may use; None runs slycot in this
+        process, without a limit.
+    rtol : float
+        Largest relative difference between the claimed level and the
+        recomputed closed-loop norm for the status ``'verified'``.
+
+    Returns
+    -------
+    SlycotReference
+        The claim, the controller, the achieved norm and the verdict.
     """
     import multiprocessing as mp
     P = as_ss(P, "P")

@@ -46,6 +46,10 @@ def hinfsyn(P, nmeas: int, ncon: int, *, solver: str = "CLARABEL", backoff: floa
         raised step by step (1e-4, 3e-4, 1e-3, ...) up to ``max_backoff``.
         Central controllers achieve their target to about 1e-8 relative on
         badly scaled random plants, so the first step normally suffices.
+    max_backoff : float
+        Largest relative backoff tried (at most 1; default 0.3, i.e. a
+        controller up to 30 % above the optimal level before the synthesis
+        gives up).
     scale : bool
         Balance the plant's states, rescale time and normalise ``u``, ``y``
         first (recommended).

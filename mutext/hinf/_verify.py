@@ -39,9 +39,20 @@ class HinfResult:
         Frequency (rad/s) of the closed-loop peak.
     stable : bool
         All closed-loop poles in the open left half plane.
-    controller_poles : ndarray
+    max_closed_loop_real_part : float
+        Largest real part of the closed-loop poles [rad/s] (negative for a
+        stable loop).
+    controller_poles : ndarray of complex
+        Poles of ``K`` [rad/s], shape ``(K.nstates,)``.
+    backoff : float
+        The relative distance above ``gamma`` at which the returned controller
+        was built (``gamma_target = gamma (1 + backoff)``).
     notes : list of str
         Properties of the problem worth knowing (singular D12/D21, D22 handling, ...).
+    solver : str
+        The cvxpy solver named for the LMIs.
+    seconds : float
+        Wall-clock time of the synthesis [s].
     info : dict
         ``level_method`` (how ``gamma`` was found), ``tries`` (every controller
         built, with its verification), ``stability`` (the verdict on the closed
