@@ -23,13 +23,38 @@ RANKED = 12
 
 
 def to_json(result: Diagnosis) -> str:
-    """The diagnosis as one JSON object (non-finite numbers as strings ``"inf"``, ``"nan"``)."""
+    """The diagnosis as one JSON object (non-finite numbers as strings ``"inf"``, ``"nan"``).
+
+    Parameters
+    ----------
+    result : Diagnosis
+        From :func:`mutext.diagnose.diagnose`.
+
+    Returns
+    -------
+    str
+        ``result.as_dict()`` as JSON text (what ``diagnosis.json`` holds).
+    """
     return _to_json(result.as_dict())
 
 
 def write_diagnosis(result: Diagnosis, out_dir) -> dict:
     """Write ``model_extended.toml`` (when there is a finding), ``diagnosis.json``, ``report.html``
-    and the figures into ``out_dir``; returns the paths written."""
+    and the figures into ``out_dir``.
+
+    Parameters
+    ----------
+    result : Diagnosis
+        From :func:`mutext.diagnose.diagnose`.
+    out_dir : path-like
+        The directory (created when missing; files of the same names are replaced).
+
+    Returns
+    -------
+    dict
+        The paths written: ``extended_model`` (when there is one, :func:`mutext.diagnose.write_model`),
+        ``figures`` (a list, :func:`diagnosis_figures`), ``json`` and ``report``.
+    """
     os.makedirs(out_dir, exist_ok=True)
     paths = {}
     model = write_model(result, out_dir)
@@ -55,7 +80,22 @@ def diagnosis_figures(result, outdir) -> list[str]:
     model for each channel; ``residual.png``: the model/data log-magnitude
     ratio over frequency before and after; ``ranking.png``: the improvement
     left after each of the best hypotheses, in units of the misfit noise alone leaves (the right
-    hypothesis brings it to about 1).
+    hypothesis brings it to about 1); ``impedance.png`` (when the misfit was localized): the
+    impedance the data require at that station beside its mass-damper-spring reading;
+    ``mbi_impedance.png`` (when model-based identification made an element): the controller K
+    beside the required impedance.
+
+    Parameters
+    ----------
+    result : Diagnosis
+        From :func:`mutext.diagnose.diagnose`.
+    outdir : path-like
+        The directory the PNG files go to (created when missing).
+
+    Returns
+    -------
+    list of str
+        The paths of the figures written, in the order above.
     """
     plt = _plt()
     os.makedirs(outdir, exist_ok=True)

@@ -7,6 +7,13 @@ import sys
 
 
 def add_arguments(p):
+    """Add the positional arguments and options of ``mutext diagnose`` to a parser.
+
+    Parameters
+    ----------
+    p : argparse.ArgumentParser
+        The sub-command's parser (changed in place).
+    """
     p.add_argument("model", nargs="?", help="model file (TOML): a lumped chain or a rotor")
     p.add_argument("data", nargs="*", help="measured FRF files (freq_hz,re,im with a '# key: value' header, or "
                                            "Universal File data set 58 .uff/.unv, all its FRFs)")
@@ -76,6 +83,24 @@ def _batch(args, prog) -> int:
 
 
 def run(args) -> int:
+    """Run ``mutext diagnose``: one model and its data sets, or ``--batch DIR``.
+
+    Parameters
+    ----------
+    args : argparse.Namespace
+        The parsed command line (the options of :func:`add_arguments`).
+
+    Returns
+    -------
+    int
+        Exit code: 0 when the diagnosis ran (for ``--batch``, when at least one data set was
+        diagnosed), 1 when every data set of a batch failed.
+
+    Raises
+    ------
+    mutext.errors.UsageError
+        Options that do not go together (exit code 2).
+    """
     _check_usage(args)
     from ..diagnose import diagnose
     from ..errors import ModelError

@@ -22,7 +22,27 @@ def extended_model_text(model_text: str, finding: Finding, model) -> str:
     """The model file's text with the finding built in (a comment names the finding).
 
     The edit is structural (:class:`mutext.rotor.model_writer.ModelFile`): the value is set in the table
-    the finding names, or a table is appended; the user's comments and layout are kept."""
+    the finding names, or a table is appended; the user's comments and layout are kept.
+
+    Parameters
+    ----------
+    model_text : str
+        The engineering model file's text (TOML, :mod:`mutext.rotor.model`).
+    finding : Finding
+        The effect to build in (its hypothesis and fitted ``value`` in the
+        unit of its kind, e.g. N/m for a stiffness).  A ``"none"`` finding
+        leaves the text unchanged; a correction of the measurement (sensor
+        gain, delay or mass, channel scale, an exciter gain on a lumped chain)
+        only adds the comment.
+    model : mutext.rotor.assembly.Structure
+        The model built from ``model_text`` (:func:`mutext.rotor.model.loads_model`):
+        the parameters and ports the finding refers to.
+
+    Returns
+    -------
+    str
+        The extended model file's text, opened by a comment line naming the finding.
+    """
     h = finding.hypothesis
     note = f"mutext diagnose: {finding.sentence()}"
     header = f"# Extended by mutext diagnose: {finding.sentence()}\n"
@@ -51,7 +71,21 @@ def write_model(result: Diagnosis, out_dir) -> str | None:
 
     Only a confirmed fix (:attr:`Diagnosis.confirmed`: explained, and better on held-out data) gets that
     name; any other extended model is written as ``model_extended_NOT_CONFIRMED.toml`` with the
-    diagnosis's status in its first lines."""
+    diagnosis's status in its first lines.  The model with the controller element of model-based
+    identification, when there is one, is written too (:func:`write_mbi_model`).
+
+    Parameters
+    ----------
+    result : Diagnosis
+        From :func:`mutext.diagnose.diagnose`; ``result.extended_model`` is set to the path written.
+    out_dir : path-like
+        The directory (created when missing).
+
+    Returns
+    -------
+    str or None
+        The path of the extended model written; None when the diagnosis found nothing to build in.
+    """
     if result.extended_model_text is None:
         write_mbi_model(result, out_dir)
         return None
@@ -98,7 +132,39 @@ def mbi_reading(model_text: str, path: str, finding: Finding, frf: FRF, excitati
 
     Only lumped chains and findings at one mass (a mass, a grounded spring or
     damper) have a single controller location; other findings raise ModelError.
-    ``progress(stage, fraction)`` is passed to :func:`mutext.mbi.identify`.
+
+    Parameters
+    ----------
+    model_text : str
+        The engineering model file's text (a lumped chain, ``[[mass]]`` tables).
+    path : str
+        The model file's path: names it in messages and resolves the files it refers to.
+    finding : Finding
+        A ``mass``, ``damping`` or ``stiffness`` finding at one mass.
+    frf : mutext.response.FRF
+        The measured channel the controller is tuned on (receptance, m/N).
+    excitation : str
+        Name of the model's force input that channel is excited at.
+    measurement : str
+        Name of the model's sensor output that channel is measured at.
+    progress : callable, optional
+        ``progress(stage, fraction)``, passed to :func:`mutext.mbi.identify`.
+
+    Returns
+    -------
+    dict
+        ``location`` (the mass's name), ``reading`` (the description of K as
+        mass, damper and spring), ``mu`` and ``Wz`` of the identification,
+        ``dm`` [kg], ``dc`` [N s/m], ``dk`` [N/m] with their standard errors
+        ``sigma`` and the fit's relative ``residual``, ``compared`` (the
+        coefficient of the finding's kind), ``mbi_value`` and ``mbi_std``,
+        ``diagnosis_value``, ``agrees`` and ``seconds``.
+
+    Raises
+    ------
+    ModelError
+        A model that is not a lumped chain, or a finding without a single
+        controller location.
     """
     return _identify_at(model_text, path, finding, frf, excitation, measurement, progress)[0]
 

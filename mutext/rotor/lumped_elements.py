@@ -50,7 +50,22 @@ class _TwoNodeTranslational(Element):
 
 
 class Spring(_TwoNodeTranslational):
-    """Linear spring [N/m] from ``node`` to ``other`` (or to ground if ``other is None``)."""
+    """Linear spring [N/m] from ``node`` to ``other`` (or to ground if ``other is None``).
+
+    Parameters
+    ----------
+    node : int
+        The first node (1-based: a mass of a lumped chain, a station of a rotor).
+    other : int, optional
+        The second node (not ``node``); None connects ``node`` to ground.
+    k : float or Param
+        Stiffness [N/m] (>= 0): a number, or a :class:`mutext.rotor.element.Param`
+        shared with other elements.  In the ``"rotor"`` layout the stiffness in x.
+    kyy : float or Param, optional
+        Stiffness in y [N/m] (``"rotor"`` layout only; default ``k``).
+    name : str, optional
+        The element's name (default: its kind and first node, e.g. ``"spring2"``).
+    """
     KIND = "spring"
     FIELDS = {"k": ("N/m", "stiffness"), "kyy": ("N/m", "stiffness in y")}
 
@@ -62,7 +77,23 @@ class Spring(_TwoNodeTranslational):
 
 
 class Damper(_TwoNodeTranslational):
-    """Linear viscous damper [N s/m] from ``node`` to ``other`` (or to ground)."""
+    """Linear viscous damper [N s/m] from ``node`` to ``other`` (or to ground).
+
+    Parameters
+    ----------
+    node : int
+        The first node (1-based: a mass of a lumped chain, a station of a rotor).
+    other : int, optional
+        The second node (not ``node``); None connects ``node`` to ground.
+    c : float or Param
+        Damping coefficient [N s/m] (>= 0): a number, or a
+        :class:`mutext.rotor.element.Param` shared with other elements.  In the
+        ``"rotor"`` layout the damping in x.
+    cyy : float or Param, optional
+        Damping in y [N s/m] (``"rotor"`` layout only; default ``c``).
+    name : str, optional
+        The element's name (default: its kind and first node, e.g. ``"damper2"``).
+    """
     KIND = "damper"
     FIELDS = {"c": ("N s/m", "damping"), "cyy": ("N s/m", "damping in y")}
     XX, YY = "c", "cyy"

@@ -79,7 +79,23 @@ class ModelFile:
             raise ModelError(f"{source}: not valid TOML: {exc}") from None
 
     def entries(self, table: str) -> list:
-        """The entries of ``[[table]]`` (or the one ``[table]``) in file order; [] when absent."""
+        """The entries of ``[[table]]`` (or the one ``[table]``) in file order; [] when absent.
+
+        Parameters
+        ----------
+        table : str
+            The table's name (``"spring"``, ``"mass"``, ``"shaft"``, ...).
+
+        Returns
+        -------
+        list of tomlkit.items.Table
+            The entries themselves (dict-like; changing one changes the document).
+
+        Raises
+        ------
+        ModelError
+            ``table`` names a value, not a table.
+        """
         if table not in self.doc:
             return []
         t = self.doc[table]
@@ -94,7 +110,35 @@ class ModelFile:
         """Set ``key = value`` in the ``k``-th entry of ``[[table]]`` that ``select`` accepts.
 
         The line gets the comment ``note (was OLD)`` after the comment it had; a key the entry does not
-        hold yet is added to it.  Returns the old value (None when added)."""
+        hold yet is added to it.
+
+        Parameters
+        ----------
+        table : str
+            The table's name (``"spring"``, ``"bearing"``, ...).
+        select : callable
+            ``select(entry) -> bool`` on each entry (a dict of its keys), e.g.
+            ``lambda t: t["name"] == "k1"``.
+        key : str
+            The key to set.
+        value : float
+            The new value, in the file's units (finite; written in full precision).
+        note : str
+            Comment on the change (may be empty).
+        k : int
+            Which of the selected entries (0-based, in file order).
+
+        Returns
+        -------
+        float or None
+            The old value; None when the key was added.
+
+        Raises
+        ------
+        ModelError
+            Fewer than ``k + 1`` entries selected, an old value that is not a number, a value that is
+            not a finite real number.
+        """
         hits = [t for t in self.entries(table) if select(t)]
         if len(hits) <= k:
             raise ModelError(f"{self.source}: no [[{table}]] entry to change '{key}' in "
@@ -114,7 +158,24 @@ class ModelFile:
         return None if old is None else float(old)
 
     def append(self, table: str, entries: dict, note: str = "") -> None:
-        """Append a ``[[table]]`` entry holding ``entries`` (a comment line ``note`` opens it)."""
+        """Append a ``[[table]]`` entry holding ``entries`` (a comment line ``note`` opens it).
+
+        Parameters
+        ----------
+        table : str
+            The table's name; the array of tables is created when the file has none.
+        entries : dict
+            Key -> value of the new entry: strings, booleans, integers and lists that hold a string
+            (e.g. ``between = ["m1", "ground"]``) as given; floats and lists of numbers (the
+            coefficients of an ``[[impedance]]``) as finite floats in full precision.
+        note : str
+            The comment line that opens the entry (none when empty).
+
+        Raises
+        ------
+        ModelError
+            ``table`` exists but is not an array of tables, or a number that is not finite.
+        """
         new = tomlkit.table()
         if note:
             new.add(tomlkit.comment(note))
@@ -142,8 +203,26 @@ class ModelFile:
     def scale(self, tables: dict, factor: float, note: str = "") -> int:
         """Multiply every key of ``tables`` (table name -> keys) present in the file by ``factor``.
 
-        Returns how many values were scaled; a listed key holding something other than a number is a
-        :class:`~mutext.errors.ModelError`."""
+        Parameters
+        ----------
+        tables : dict
+            Table name -> list of keys, e.g. ``{"damper": ["damping"]}``; keys an entry does not hold are
+            skipped.
+        factor : float
+            The multiplier (finite).
+        note : str
+            Comment on each changed line (the old value is added to it, as by :meth:`set`).
+
+        Returns
+        -------
+        int
+            How many values were scaled.
+
+        Raises
+        ------
+        ModelError
+            A listed key holding something other than a number, a factor that is not finite.
+        """
         _number(factor, f"{self.source}: scale factor")
         count = 0
         for table, keys in tables.items():
