@@ -1,14 +1,15 @@
 """Autograder of exercise ex02_mu: scores, feedback, integrity (mutext.mu, mutext.uncertain, mutext.dk blocked).
 
-The submissions ``tests/grading_submissions/ex02_*.py``, the reference
-solution and the stub are graded once, two at a time in the background; the
-diagnoses are also checked in-process on constructed answers.
+On the inputs of one seed the reference solution and the submission that imports mutext.mu are graded
+confined (tests/grading_harness.py: once, in the background); the stub and the other submissions
+``tests/grading_submissions/ex02_*.py`` go through the same grader with their functions run in this
+process (confined with ``-m slow``); the diagnoses are also checked in-process on constructed answers.
 """
 
 import numpy as np
 import pytest
 
-from grading_harness import ROOT, GradedSubmissions, full, q
+from grading_harness import ROOT, Submissions, assert_same_scores_and_feedback, full, q
 from mutext import cli
 from mutext_grader import ex02_mu as ex02
 from mutext_grader.solutions import ex02_mu as sol
@@ -16,8 +17,10 @@ from mutext_grader.solutions import ex02_mu as sol
 EXERCISE = "ex02_mu"
 SP = np.array([[2.0, 2.0], [-1.0, -1.0]])     # Skogestad & Postlethwaite, example 8.5
 SEED = 20240611
-graded = GradedSubmissions(EXERCISE)
+graded = Submissions(EXERCISE, SEED, confined=("reference", "ex02_cheat_mu"))
 SUBMISSIONS = graded.paths
+#: graded in this process by default, confined with -m slow
+HERE = sorted(n for n in SUBMISSIONS if n not in graded.confined)
 
 
 # ----------------------------------------------------------------------------
@@ -32,7 +35,7 @@ def test_reference_solution_scores_full_marks():
 
 
 def test_stub_scores_zero_without_crashing():
-    rep = graded("stub")
+    rep = graded.here("stub")
     assert rep.score == 0
     for x in rep.questions:
         assert x.status == "ok"
@@ -40,7 +43,7 @@ def test_stub_scores_zero_without_crashing():
 
 
 def test_spectral_radius_and_unscaled_norms_are_named():
-    rep = graded("ex02_spectral_radius")
+    rep = graded.here("ex02_spectral_radius")
     assert q(rep, "a1").score == 0
     assert "returned the spectral radius max|eig(M)|, not the largest singular value" in q(rep, "a1").output
     assert q(rep, "a2").score == 0 and "no D-scaling: this is sigma_max(M)" in q(rep, "a2").output
@@ -52,7 +55,7 @@ def test_spectral_radius_and_unscaled_norms_are_named():
 
 
 def test_dmd_and_sign_mistakes_are_named():
-    rep = graded("ex02_dmd_sign")
+    rep = graded.here("ex02_dmd_sign")
     assert full(rep, "a1", "d")
     a2 = q(rep, "a2")
     # the same diagnosis for every matrix is said once
@@ -63,7 +66,7 @@ def test_dmd_and_sign_mistakes_are_named():
 
 
 def test_crude_numerics_earn_nothing():
-    rep = graded("ex02_crude")
+    rep = graded.here("ex02_crude")
     a1 = q(rep, "a1")
     assert a1.score == 0, rep.text()         # a1's matrices all have rank two: Frobenius > sigma_max
     assert a1.output.count("returned the Frobenius norm") == 1   # said once for the four
@@ -88,7 +91,14 @@ def test_importing_mutext_mu_is_blocked():
 def test_every_wrong_submission_scores_less():
     for name in SUBMISSIONS:
         if name.startswith("ex02_"):
-            assert graded(name).score < 10, name
+            assert (graded(name) if name in graded.confined else graded.here(name)).score < 10, name
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("name", HERE)
+def test_confined_run_agrees_with_the_run_in_process(name):
+    """What the default run checks on the functions run in this process holds for the confined run."""
+    assert_same_scores_and_feedback(graded(name), graded.here(name))
 
 
 # ----------------------------------------------------------------------------

@@ -1,22 +1,20 @@
 """Autograder of exercise ex03_free_decay: scores, feedback, integrity (mutext.sysid blocked).
 
-The submissions ``tests/grading_submissions/ex03_*.py``, the reference
-solution, the stub and one trivial submission are graded once on the inputs
-of one seed, two at a time in the background (the reference on two more
-seeds); the trivial submissions ``tests/grading_submissions/trivial/ex03_*.py``
-are scored in-process on several seeds (graded one by one with ``-m slow``);
-the feedback of each diagnosis is also checked in-process on constructed
-answers, and on the inputs of several seeds, that it never contains a
-reference value.
+On the inputs of one seed the reference solution and a submission importing mutext.sysid are graded
+confined (tests/grading_harness.py: once, in the background); the stub, the submissions
+``tests/grading_submissions/ex03_*.py`` and one trivial submission go through the same grader with their
+functions run in this process (all of them confined, and the reference on two more seeds, with
+``-m slow``); the trivial submissions ``tests/grading_submissions/trivial/ex03_*.py`` are scored
+in-process on several seeds; the feedback of each diagnosis is also checked in-process on constructed
+answers, and on the inputs of several seeds, that it never contains a reference value.
 """
-import importlib.util
 import math
 import re
 
 import numpy as np
 import pytest
 
-from grading_harness import ROOT, SUBS, GradedSubmissions, full, q
+from grading_harness import ROOT, SUBS, Submissions, assert_same_scores_and_feedback, full, load, q
 from mutext import cli
 from mutext_grader import ex03_free_decay as ex03
 from mutext_grader import grade
@@ -26,31 +24,19 @@ EXERCISE = "ex03_free_decay"
 SEED = 20250611                  # the inputs of the graded submissions (any seed must do)
 MORE_SEEDS = (7, 123456789)      # the reference solution scores full marks on these too
 TRIVIAL = {p.stem: p for p in (SUBS / "trivial").glob("ex03_*.py")}
+SYSID_CHEAT = ((ROOT / "exercises" / "ex03_free_decay.py").read_text() + "\n\n"
+               "def stiffness(omega_bare, m_c):\n"
+               "    import mutext.sysid\n"
+               "    return omega_bare**2 * m_c\n"
+               "\n\n"
+               "def cart_mass(omega_bare, omega_weighted, m_w):\n"
+               "    return m_w * omega_weighted**2 / (omega_bare**2 - omega_weighted**2)\n")
 
-
-class SeededSubmissions(GradedSubmissions):
-    """:class:`GradedSubmissions` graded on the inputs of ``seed``, with the trivial submissions and the
-    reference on further seeds (``"reference@7"``)."""
-
-    def __init__(self, exercise, seed, more_seeds=()):
-        super().__init__(exercise)
-        self.seed = seed
-        self.paths["ex03_constants"] = TRIVIAL["ex03_constants"]
-        self.runs = {n: (p, seed) for n, p in self.paths.items()}
-        self.runs.update({f"reference@{s}": (self.paths["reference"], s) for s in more_seeds})
-
-    def __call__(self, name):
-        with self._lock:
-            if not self._futures:
-                for n in sorted(self.runs, key=lambda n: not n.startswith("reference")):
-                    path, seed = self.runs[n]
-                    self._futures[n] = self._pool.submit(grade, self.exercise, path, self.timeout, seed=seed)
-        return self._futures[name].result()
-
-
-graded = SeededSubmissions(EXERCISE, SEED, MORE_SEEDS)
+graded = Submissions(EXERCISE, SEED, extra={"ex03_constants": TRIVIAL["ex03_constants"]})
 SUBMISSIONS = graded.paths
 CASES = ex03.draw(np.random.default_rng(SEED))       # the inputs the submissions above were graded on
+#: graded in this process by default, confined with -m slow
+HERE = sorted(n for n in SUBMISSIONS if n != "reference")
 
 
 # ----------------------------------------------------------------------------
@@ -74,15 +60,22 @@ def test_reference_solution_scores_full_marks():
 
 @pytest.mark.parametrize("seed", MORE_SEEDS)
 def test_reference_solution_scores_full_marks_on_other_seeds(seed):
-    rep = graded(f"reference@{seed}")
+    rep = graded.here("reference", seed)
     assert rep.score == 10 and rep.inputs == f"drawn from seed {seed}", rep.text()
 
 
-def _load(path):
-    spec = importlib.util.spec_from_file_location(f"trivial_{path.stem}", path)
-    mod = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(mod)
-    return mod
+@pytest.mark.slow
+@pytest.mark.parametrize("seed", MORE_SEEDS)
+def test_reference_solution_scores_full_marks_on_other_seeds_confined(seed):
+    rep = graded("reference", seed)
+    assert rep.score == 10 and rep.inputs == f"drawn from seed {seed}", rep.text()
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("name", HERE)
+def test_confined_run_agrees_with_the_run_in_process(name):
+    """What the default run checks on the functions run in this process holds for the confined run."""
+    assert_same_scores_and_feedback(graded(name), graded.here(name))
 
 
 def _scores(qs, mod):
@@ -103,7 +96,7 @@ def _scores(qs, mod):
 def test_trivial_submissions_score_zero(name):
     """Constants (the thesis's cart), zeros, returned arguments and numpy one-liners that are not eqs.
     3.1-3.5 (a plain FFT's largest bin, the first over the last sample) earn nothing, on any draw."""
-    mod = _load(TRIVIAL[name])
+    mod = load(TRIVIAL[name])
     for seed in (SEED, 1, 2, 3, 4):
         scores = _scores(_questions(seed), mod)
         assert all(v == 0 for v in scores.values()), (seed, scores)
@@ -117,7 +110,7 @@ def test_trivial_submissions_graded_score_zero(name):
 
 
 def test_constants_are_named():
-    rep = graded("ex03_constants")
+    rep = graded.here("ex03_constants")
     assert rep.score == 0
     for qid in ("a1", "a2", "b1", "b2", "c"):
         assert "every call returned the same value although the inputs differ" in q(rep, qid).output
@@ -125,7 +118,7 @@ def test_constants_are_named():
 
 
 def test_stub_scores_zero_without_crashing():
-    rep = graded("stub")
+    rep = graded.here("stub")
     assert rep.score == 0
     for x in rep.questions:
         assert x.status == "ok"
@@ -133,7 +126,7 @@ def test_stub_scores_zero_without_crashing():
 
 
 def test_printed_eq_3_3_is_named():
-    rep = graded("ex03_thesis_eq33")
+    rep = graded.here("ex03_thesis_eq33")
     assert full(rep, "a1", "a2", "b2", "c")
     b1 = q(rep, "b1")
     assert b1.score == 0 and b1.output.count("this is m_c + m_w") == 3
@@ -145,7 +138,7 @@ def test_printed_eq_3_3_is_named():
 
 
 def test_hz_instead_of_rad_per_s_is_named():
-    rep = graded("ex03_hz")
+    rep = graded.here("ex03_hz")
     a1 = q(rep, "a1")
     assert a1.score == 0 and a1.output.count("Hz instead of rad/s") == 3
     assert full(rep, "a2", "b1", "b2", "c")
@@ -156,7 +149,7 @@ def test_hz_instead_of_rad_per_s_is_named():
 
 
 def test_decrement_not_divided_by_cycles_is_named():
-    rep = graded("ex03_decrement_not_per_cycle")
+    rep = graded.here("ex03_decrement_not_per_cycle")
     a2 = q(rep, "a2")
     assert a2.score == 0
     for *_, n, _x0, _duration in CASES["a"]:
@@ -170,7 +163,7 @@ def test_decrement_not_divided_by_cycles_is_named():
 def test_every_wrong_submission_scores_less():
     for name in SUBMISSIONS:
         if name.startswith("ex03_"):
-            assert graded(name).score < 10, name
+            assert graded.here(name).score < 10, name
 
 
 # ----------------------------------------------------------------------------
@@ -277,14 +270,8 @@ def test_listed_stub_and_blocked_modules():
 
 def test_importing_mutext_sysid_is_blocked(tmp_path):
     sub = tmp_path / "cheat.py"
-    sub.write_text((ROOT / "exercises" / "ex03_free_decay.py").read_text() + "\n\n"
-                   "def stiffness(omega_bare, m_c):\n"
-                   "    import mutext.sysid\n"
-                   "    return omega_bare**2 * m_c\n"
-                   "\n\n"
-                   "def cart_mass(omega_bare, omega_weighted, m_w):\n"
-                   "    return m_w * omega_weighted**2 / (omega_bare**2 - omega_weighted**2)\n")
-    rep = grade(EXERCISE, sub, 60.0)
+    sub.write_text(SYSID_CHEAT)
+    rep = grade(EXERCISE, sub, 60.0, seed=SEED)
     b2 = q(rep, "b2")
     assert b2.score == 0 and b2.status == "violation" and "importing mutext.sysid" in b2.output
     assert full(rep, "b1") and rep.score == 1.5

@@ -1,21 +1,21 @@
 """Autograder of exercise ex04_beam_element: scores, feedback, integrity (mutext.rotor blocked).
 
-The submissions ``tests/grading_submissions/ex04_*.py``, the reference
-solution, the stub and one trivial submission are graded once on the inputs
-of one seed, two at a time in the background (the reference on two more
-seeds); the trivial submissions ``tests/grading_submissions/trivial/ex04_*.py``
-are scored in-process on several seeds (graded one by one with ``-m slow``);
-the feedback of each diagnosis is also checked in-process on constructed
+On the inputs of one seed the reference solution, the submission that imports and reads mutext.rotor
+and one trivial submission with oversized arrays are graded confined (tests/grading_harness.py: once,
+in the background); the stub and the submissions ``tests/grading_submissions/ex04_*.py`` go through
+the same grader with their functions run in this process (all of them confined, and the reference on
+two more seeds, with ``-m slow``); the trivial submissions
+``tests/grading_submissions/trivial/ex04_*.py`` are scored in-process on several seeds (graded one by
+one with ``-m slow``); the feedback of each diagnosis is also checked in-process on constructed
 answers, and that it never contains a reference value.
 """
-import importlib.util
 import math
 import re
 
 import numpy as np
 import pytest
 
-from grading_harness import ROOT, SUBS, GradedSubmissions, full, q
+from grading_harness import ROOT, SUBS, Submissions, assert_same_scores_and_feedback, full, load, q
 from mutext import cli
 from mutext_grader import ex04_beam_element as ex04
 from mutext_grader import grade
@@ -26,29 +26,12 @@ SEED = 20250611                  # the inputs of the graded submissions (any see
 MORE_SEEDS = (7, 123456789)      # the reference solution scores full marks on these too
 TRIVIAL = {p.stem: p for p in (SUBS / "trivial").glob("ex04_*.py")}
 
-
-class SeededSubmissions(GradedSubmissions):
-    """:class:`GradedSubmissions` graded on the inputs of ``seed``, with one trivial submission and the
-    reference on further seeds (``"reference@7"``)."""
-
-    def __init__(self, exercise, seed, more_seeds=()):
-        super().__init__(exercise)
-        self.paths["ex04_oversized"] = TRIVIAL["ex04_oversized"]
-        self.runs = {n: (p, seed) for n, p in self.paths.items()}
-        self.runs.update({f"reference@{s}": (self.paths["reference"], s) for s in more_seeds})
-
-    def __call__(self, name):
-        with self._lock:
-            if not self._futures:
-                for n in sorted(self.runs, key=lambda n: not n.startswith("reference")):
-                    path, seed = self.runs[n]
-                    self._futures[n] = self._pool.submit(grade, self.exercise, path, self.timeout, seed=seed)
-        return self._futures[name].result()
-
-
-graded = SeededSubmissions(EXERCISE, SEED, MORE_SEEDS)
+graded = Submissions(EXERCISE, SEED, extra={"ex04_oversized": TRIVIAL["ex04_oversized"]},
+                     confined=("reference", "ex04_cheat_rotor", "ex04_oversized"))
 SUBMISSIONS = graded.paths
 CASES = ex04.draw(np.random.default_rng(SEED))       # the inputs the submissions above were graded on
+#: graded in this process by default, confined with -m slow
+HERE = sorted(n for n in SUBMISSIONS if n not in graded.confined)
 
 
 # ----------------------------------------------------------------------------
@@ -70,8 +53,22 @@ def test_reference_solution_scores_full_marks():
 
 @pytest.mark.parametrize("seed", MORE_SEEDS)
 def test_reference_solution_scores_full_marks_on_other_seeds(seed):
-    rep = graded(f"reference@{seed}")
+    rep = graded.here("reference", seed)
     assert rep.score == 10 and rep.inputs == f"drawn from seed {seed}", rep.text()
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("seed", MORE_SEEDS)
+def test_reference_solution_scores_full_marks_on_other_seeds_confined(seed):
+    rep = graded("reference", seed)
+    assert rep.score == 10 and rep.inputs == f"drawn from seed {seed}", rep.text()
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("name", HERE)
+def test_confined_run_agrees_with_the_run_in_process(name):
+    """What the default run checks on the functions run in this process holds for the confined run."""
+    assert_same_scores_and_feedback(graded(name), graded.here(name))
 
 
 def test_oversized_arrays_score_zero_unanalysed():
@@ -84,7 +81,7 @@ def test_oversized_arrays_score_zero_unanalysed():
 
 
 def test_stub_scores_zero_without_crashing():
-    rep = graded("stub")
+    rep = graded.here("stub")
     assert rep.score == 0
     for x in rep.questions:
         assert x.status == "ok"
@@ -92,7 +89,7 @@ def test_stub_scores_zero_without_crashing():
 
 
 def test_lumped_mass_is_named():
-    rep = graded("ex04_lumped_mass")
+    rep = graded.here("ex04_lumped_mass")
     a = q(rep, "a")
     assert a.score == 1.5                    # K right, M wrong at both parameter sets
     assert "mass matrix is lumped, not consistent" in a.output
@@ -103,7 +100,7 @@ def test_lumped_mass_is_named():
 
 
 def test_missing_factor_L_is_named():
-    rep = graded("ex04_missing_L")
+    rep = graded.here("ex04_missing_L")
     a = q(rep, "a")
     assert a.score == 1.5
     assert "a factor L is missing in the rotational terms of the stiffness matrix K" in a.output
@@ -113,7 +110,7 @@ def test_missing_factor_L_is_named():
 
 
 def test_supports_not_applied_is_named():
-    rep = graded("ex04_no_supports")
+    rep = graded.here("ex04_no_supports")
     assert full(rep, "a")
     b = q(rep, "b")
     assert b.score == 1.0                    # right free-beam matrices: half the points
@@ -132,7 +129,7 @@ def test_supports_not_applied_is_named():
 
 
 def test_hz_and_pinned_beta_for_cantilever_are_named():
-    rep = graded("ex04_hz_and_pi")
+    rep = graded.here("ex04_hz_and_pi")
     assert full(rep, "a", "b")
     assert q(rep, "c").score == 0 and "these are in Hz: return rad/s" in q(rep, "c").output
     d = q(rep, "d")
@@ -157,7 +154,7 @@ def test_importing_or_reading_mutext_rotor_is_blocked():
 def test_every_wrong_submission_scores_less():
     for name in SUBMISSIONS:
         if name.startswith("ex04_"):
-            assert graded(name).score < 10, name
+            assert (graded(name) if name in graded.confined else graded.here(name)).score < 10, name
 
 
 # ----------------------------------------------------------------------------
@@ -388,18 +385,11 @@ def test_draws_vary_what_matters():
     assert seen["modes"] == {("pinned", 1), ("pinned", 2), ("cantilever", 1), ("cantilever", 2), ("cantilever", 3)}
 
 
-def _load(path):
-    spec = importlib.util.spec_from_file_location(f"trivial_{path.stem}", path)
-    mod = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(mod)
-    return mod
-
-
 @pytest.mark.parametrize("name", sorted(set(TRIVIAL) - {"ex04_oversized"}))
 def test_trivial_submissions_score_zero(name):
     """Zeros, identity matrices scaled by the arguments, constants, and the closed-form frequencies in place
     of the finite-element ones earn nothing, on any draw."""
-    mod = _load(TRIVIAL[name])
+    mod = load(TRIVIAL[name])
     for seed in (SEED, 1, 2):
         for qid, qu in _questions(seed).items():
             outcomes = []

@@ -1,47 +1,29 @@
 """Autograder of exercise ex05_diagnose: drawn inputs, scores and feedback of the reference, the stub,
-common mistakes and submissions that do not solve."""
+common mistakes and submissions that do not solve.
+
+On the inputs of one seed the reference solution is graded confined (tests/grading_harness.py: once,
+in the background); the stub, the mistakes ``tests/grading_submissions/ex05_*.py`` and the trivial
+submissions go through the same grader with their functions run in this process (confined, and the
+reference on two more seeds, with ``-m slow``)."""
 import re
-import threading
-from concurrent.futures import ThreadPoolExecutor
-from pathlib import Path
 
 import numpy as np
 import pytest
 
-from grading_harness import full, q
+from grading_harness import SUBS, Submissions, assert_same_scores_and_feedback, full, q
 from mutext_grader import ex05_diagnose as ex05
-from mutext_grader import grade
 from mutext_grader.compare import fmt
 
-ROOT = Path(__file__).resolve().parents[1]
-SUBS = Path(__file__).resolve().parent / "grading_submissions"
-PATHS = {
-    "reference": ROOT / "instructor" / "mutext_grader" / "solutions" / "ex05_diagnose.py",
-    "stub": ROOT / "exercises" / "ex05_diagnose.py",
-    **{p.stem: p for p in SUBS.glob("ex05_*.py")},
-    **{p.stem: p for p in (SUBS / "trivial").glob("ex05_*.py")},
-}
 #: the seed of most checks: it draws one "none" case of four in (d), and no grounded spring at mass 1
 SEED = 6
 #: two more seeds for the reference solution (slow)
 MORE_SEEDS = (1, 2)
 TRIVIAL = ("ex05_always_none", "ex05_constant_effect", "ex05_model_only")
 
-_pool = ThreadPoolExecutor(max_workers=2)
-_futures = {}
-_lock = threading.Lock()
-
-
-def graded(name, seed=SEED):
-    """The report of a submission graded on the inputs drawn from ``seed`` (every submission of the
-    default seed is started, two at a time, the first time one is asked for)."""
-    with _lock:
-        if not _futures:
-            for n in sorted(PATHS, key=lambda n: n != "reference"):
-                _futures[(n, SEED)] = _pool.submit(grade, "ex05_diagnose", PATHS[n], 60.0, seed=SEED)
-        if (name, seed) not in _futures:
-            _futures[(name, seed)] = _pool.submit(grade, "ex05_diagnose", PATHS[name], 60.0, seed=seed)
-        return _futures[(name, seed)].result()
+graded = Submissions("ex05_diagnose", SEED, extra={p.stem: p for p in (SUBS / "trivial").glob("ex05_*.py")})
+PATHS = graded.paths
+#: graded in this process by default, confined with -m slow
+HERE = sorted(n for n in PATHS if n not in graded.confined)
 
 
 def drawn(seed=SEED):
@@ -72,6 +54,13 @@ def test_reference_solution_scores_full_marks_on_other_seeds(seed):
 
 
 @pytest.mark.slow
+@pytest.mark.parametrize("name", HERE)
+def test_confined_run_agrees_with_the_run_in_process(name):
+    """What the default run checks on the functions run in this process holds for the confined run."""
+    assert_same_scores_and_feedback(graded(name), graded.here(name))
+
+
+@pytest.mark.slow
 def test_reference_solution_is_right_on_many_draws():
     """In process, without the confined child: every question of 20 more draws scored in full."""
     from mutext_grader.solutions import ex05_diagnose as sol
@@ -90,13 +79,13 @@ def test_reference_solution_is_right_on_many_draws():
 
 
 def test_stub_scores_zero_without_crashing():
-    rep = graded("stub")
+    rep = graded.here("stub")
     assert rep.score == 0
     assert all(x.status == "ok" for x in rep.questions)
 
 
 def test_unwrapped_phase_is_named():
-    rep = graded("ex05_unwrapped_phase")
+    rep = graded.here("ex05_unwrapped_phase")
     a = q(rep, "a")
     assert 0 < a.score < a.max_score
     assert "log of the ratio" in a.output
@@ -105,7 +94,7 @@ def test_unwrapped_phase_is_named():
 
 def test_zero_based_station_is_named():
     """The stations one too low: no effect is found, so the "none" case does not count either."""
-    rep = graded("ex05_zero_based")
+    rep = graded.here("ex05_zero_based")
     d = q(rep, "d")
     assert d.score == 0
     assert "the kind is right, the station is not" in d.output
@@ -114,13 +103,13 @@ def test_zero_based_station_is_named():
 
 
 def test_hz_as_rad_s_is_named():
-    rep = graded("ex05_hz_as_rad")
+    rep = graded.here("ex05_hz_as_rad")
     b = q(rep, "b")
     assert b.score == 0 and "frequencies taken as rad/s" in b.output
 
 
 def test_never_none_loses_the_none_cases():
-    rep = graded("ex05_never_none")
+    rep = graded.here("ex05_never_none")
     d = q(rep, "d")
     n_none = [k[0] for k in d_keys()].count("none")
     assert d.score == pytest.approx(d.max_score * (1 - n_none / ex05.N_D), abs=0.01)
@@ -131,7 +120,7 @@ def test_never_none_loses_the_none_cases():
 def test_submissions_that_do_not_solve_score_nothing(name):
     """Constants, inputs handed back and the model's own response earn nothing on (a)-(c); on (d) a
     constant kind and station earns only the cases it happens to match (none at this seed)."""
-    rep = graded(name)
+    rep = graded.here(name)
     assert all(x.status == "ok" for x in rep.questions)
     assert rep.score == 0, rep.text()
 
@@ -177,7 +166,7 @@ def test_feedback_names_no_hidden_parameter():
     value of a hidden case is printed."""
     qs = drawn()
     for name in ("ex05_zero_based", "ex05_constant_effect", "ex05_model_only", "ex05_never_none"):
-        rep = graded(name)
+        rep = graded.here(name)
         text = rep.text()
         for call in qs["c"].calls:
             assert fmt(call.ref) not in text and f"{call.ref:g}" not in text
