@@ -15,14 +15,14 @@ from ._mpl import db as _db, pyplot as _plt, save as _save
 from .lti import as_ss, freqresp, sigma_max
 from .report import diagnosis_figures
 
-__all__ = ["frequency_grid", "bode_mag", "bode_phase", "sigma_plot", "closed_loop_figure",
+__all__ = ["systems_grid", "bode_mag", "bode_phase", "sigma_plot", "closed_loop_figure",
            "controller_figure", "sigma_figure", "two_mass_hinf_figures", "mbi_figure", "diagnosis_figures",
            "sideband_figure", "crack_identification_figure", "crack_figures",
            "campbell_figure", "mode_shapes_figure", "unbalance_bode_figure", "unbalance_polar_figure",
            "orbit_figure"]
 
 
-def frequency_grid(*systems, decades: float = 1.5, n: int = 800) -> np.ndarray:
+def systems_grid(*systems, decades: float = 1.5, n: int = 800) -> np.ndarray:
     """Log-spaced grid (rad/s) covering the pole magnitudes of ``systems``.
 
     :func:`mutext.response.frequency_grid` over their poles: the grid extends
@@ -42,8 +42,8 @@ def frequency_grid(*systems, decades: float = 1.5, n: int = 800) -> np.ndarray:
     Examples
     --------
     >>> from mutext.lti import ss
-    >>> from mutext.plots import frequency_grid
-    >>> w = frequency_grid(ss([[-10.0]], [[1.0]], [[1.0]], [[0.0]]), n=100)
+    >>> from mutext.plots import systems_grid
+    >>> w = systems_grid(ss([[-10.0]], [[1.0]], [[1.0]], [[0.0]]), n=100)
     >>> bool(w.min() < 1.0 and w.max() > 100.0)          # 1.5 decades either side of 10 rad/s
     True
     """
@@ -138,7 +138,7 @@ def closed_loop_figure(CL, omega=None, P=None, input_names=None, output_names=No
     CL : control.StateSpace
         Closed loop ``w -> z``.
     omega : array_like, optional
-        Frequencies in rad/s (default: :func:`frequency_grid`).
+        Frequencies in rad/s (default: :func:`systems_grid`).
     P : control.StateSpace, optional
         Generalized plant; if given, its open-loop ``w -> z`` channels
         (control input left at zero) are drawn dashed for comparison.
@@ -155,7 +155,7 @@ def closed_loop_figure(CL, omega=None, P=None, input_names=None, output_names=No
     CL = as_ss(CL)
     nz, nw = CL.noutputs, CL.ninputs
     if omega is None:
-        omega = frequency_grid(CL) if P is None else frequency_grid(CL, P)
+        omega = systems_grid(CL) if P is None else systems_grid(CL, P)
     omega = np.asarray(omega, float)
     input_names = input_names or list(CL.input_labels)
     output_names = output_names or list(CL.output_labels)
@@ -197,7 +197,7 @@ def controller_figure(K, omega=None, title=None):
     K : control.StateSpace or as accepted by :func:`mutext.lti.as_ss`
         The SISO controller.
     omega : array_like, optional
-        Frequencies in rad/s (default: :func:`frequency_grid` of ``K``).
+        Frequencies in rad/s (default: :func:`systems_grid` of ``K``).
     title : str, optional
         Title of the figure.
 
@@ -207,7 +207,7 @@ def controller_figure(K, omega=None, title=None):
     """
     plt = _plt()
     K = as_ss(K)
-    omega = frequency_grid(K) if omega is None else np.asarray(omega, float)
+    omega = systems_grid(K) if omega is None else np.asarray(omega, float)
     fig, (a1, a2) = plt.subplots(2, 1, figsize=(6.4, 5.0), sharex=True)
     bode_mag(a1, K, omega)
     a1.set_xlabel("")
@@ -239,7 +239,7 @@ def sigma_figure(CL, omega=None, levels=None, title=None):
     """
     plt = _plt()
     CL = as_ss(CL)
-    omega = frequency_grid(CL) if omega is None else np.asarray(omega, float)
+    omega = systems_grid(CL) if omega is None else np.asarray(omega, float)
     fig, ax = plt.subplots(figsize=(6.4, 3.6))
     sigma_plot(ax, CL, omega, label="closed loop")
     styles = iter([":", "--", "-.", (0, (1, 3))])
@@ -278,7 +278,7 @@ def two_mass_hinf_figures(res, P, outdir, thesis_gamma: float | None = None) -> 
     plt = _plt()
     os.makedirs(outdir, exist_ok=True)
     omega = np.logspace(-1, 3, 1200)
-    omega = np.unique(np.concatenate([omega, frequency_grid(P, decades=0.5, n=2)]))
+    omega = np.unique(np.concatenate([omega, systems_grid(P, decades=0.5, n=2)]))
     levels = {"optimal gamma (LMI)": res.gamma}
     if thesis_gamma is not None:
         levels["thesis gamma"] = thesis_gamma

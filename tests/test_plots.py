@@ -32,7 +32,7 @@ def test_two_mass_figures_saved(design, tmp_path):
 
 def test_small_functions_draw(design):
     res, P = design
-    w = plots.frequency_grid(P)
+    w = plots.systems_grid(P)
     assert np.all(np.diff(w) > 0) and w[0] < 7.46 < w[-1]
     fig, ax = plt.subplots()
     plots.bode_mag(ax, P, w, out_index=0, in_index=0)

@@ -81,7 +81,7 @@ from ..errors import IllPosedError, ModelError, MutextError
 from ..lti import blas_single_thread, mck_to_ss
 from ..response import FRFMatrix
 
-__all__ = ["Modes", "FRF", "Campbell", "modes", "natural_frequencies", "campbell", "frf",
+__all__ = ["Modes", "Campbell", "modes", "natural_frequencies", "campbell", "frf",
            "state_space", "whirl_index", "blas_single_thread"]
 
 
@@ -137,8 +137,6 @@ def whirl_label(w: float, threshold: float = 0.5) -> str:
     return "forward" if w > threshold else "backward" if w < -threshold else "mixed"
 
 
-#: A model's responses between named ports (one home for frequency responses: :mod:`mutext.response`).
-FRF = FRFMatrix
 
 
 @dataclass
@@ -453,7 +451,7 @@ def _ports(model, inputs, outputs):
 
 
 def frf(model, freqs_hz, *, inputs: Sequence[str] | None = None, outputs: Sequence[str] | None = None,
-        speed: float | None = None, values=None) -> FRF:
+        speed: float | None = None, values=None) -> FRFMatrix:
     """Frequency responses between named ports at ``freqs_hz`` [Hz].
 
     Default ports: all inputs and outputs of the model.  Returns an
@@ -514,7 +512,7 @@ def frf(model, freqs_hz, *, inputs: Sequence[str] | None = None, outputs: Sequen
     return out
 
 
-def _frf(model, f, ins, outs, speed, v) -> FRF:
+def _frf(model, f, ins, outs, speed, v) -> FRFMatrix:
     M, C, K, G = model.matrices(v)
     B = model.input_matrix(v)[:, [model.input_names.index(q) for q in ins]]
     Cy = model.output_matrix()[[model.output_names.index(q) for q in outs]]
