@@ -61,15 +61,6 @@ def graded(exercise, path, seed, time_limit=60.0):
     return _futures[_key(exercise, path, seed, time_limit)].result()
 
 
-def memoised_grade(exercise, submission, time_limit=60.0, *, require_isolation=False, secret=None, seed=None):
-    """:func:`mutext_grader.grade` for the command line tests: a run with a seed and nothing else is the
-    memoised :func:`graded` (``mutext grade ... --seed N`` and a test on the same file share one child)."""
-    if seed is None or require_isolation or secret is not None:
-        return grade(exercise, submission, time_limit, require_isolation=require_isolation, secret=secret,
-                     seed=seed)
-    return graded(exercise, submission, seed, time_limit)
-
-
 # ----------------------------------------------------------------------------------------------------------
 # the grader with the submission's functions run in this process
 # ----------------------------------------------------------------------------------------------------------
@@ -150,6 +141,18 @@ def graded_here(exercise, path, seed):
         return _here[key]
 
 
+def memoised_grade(here=False):
+    """A stand-in for :func:`mutext_grader.grade` in the command line's module: a run with a seed and
+    nothing else is the memoised :func:`graded` (``here``: :func:`graded_here`), so ``mutext grade FILE
+    --seed N`` and a test on the same file share one run; any other run is graded as usual."""
+    def grade_(exercise, submission, time_limit=60.0, *, require_isolation=False, secret=None, seed=None):
+        if seed is None or require_isolation or secret is not None or (here and time_limit != 60.0):
+            return grade(exercise, submission, time_limit, require_isolation=require_isolation, secret=secret,
+                         seed=seed)
+        return graded_here(exercise, submission, seed) if here else graded(exercise, submission, seed, time_limit)
+    return grade_
+
+
 # ----------------------------------------------------------------------------------------------------------
 # the submissions of an exercise
 # ----------------------------------------------------------------------------------------------------------
@@ -162,7 +165,7 @@ class Submissions:
     reference first; ``graded.here(name)`` runs the functions in this process; ``seed`` overrides the
     module's seed for one run."""
 
-    def __init__(self, exercise, seed, *, extra=None, confined=("reference",), time_limit=60.0):
+    def __init__(self, exercise, seed, *, extra=None, confined=("reference",), time_limit=60.0, time_limits=None):
         self.exercise = get_exercise(exercise).name
         self.seed = seed
         self.time_limit = time_limit
@@ -174,13 +177,17 @@ class Submissions:
             **(extra or {}),
         }
         self.confined = tuple(confined)
+        self.time_limits = dict(time_limits or {})       # name -> seconds, for a run with its own limit
         self._started = False
+
+    def _limit(self, name):
+        return self.time_limits.get(name, self.time_limit)
 
     def __call__(self, name, seed=None):
         if not self._started:
             self._started = True
-            prefetch([(self.exercise, self.paths[n], self.seed, self.time_limit) for n in self.confined])
-        return graded(self.exercise, self.paths[name], self.seed if seed is None else seed, self.time_limit)
+            prefetch([(self.exercise, self.paths[n], self.seed, self._limit(n)) for n in self.confined])
+        return graded(self.exercise, self.paths[name], self.seed if seed is None else seed, self._limit(name))
 
     def here(self, name, seed=None):
         return graded_here(self.exercise, self.paths[name], self.seed if seed is None else seed)

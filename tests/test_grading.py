@@ -1,64 +1,42 @@
 """The offline autograder (``mutext grade``): scores, feedback, time limits, integrity, CLI.
 
-Each submission in ``tests/grading_submissions`` is graded once, two at a
-time in the background, and the tests assert on the reports.
+The submissions in ``tests/grading_submissions`` (ex01) are graded on the inputs of one seed
+(tests/grading_harness.py): those the confined child is there for (the reference, the cheating, endless
+and crashing ones) confined, once each, two at a time in the background; the stub, the wrong answers and
+the files the command line tests grade go through the same grader with their functions run in this
+process (confined with ``-m slow``, compared with the in-process run; a syntax error and an exception in
+a function are graded confined in tests/test_grading_batch.py and tests/test_grading_hostile.py too).
 """
 import json
 import re
-import threading
-import time
-from concurrent.futures import ThreadPoolExecutor
-from pathlib import Path
 
 import numpy as np
 import pytest
 
+from grading_harness import SUBS, Submissions, assert_same_scores_and_feedback, full, memoised_grade, q
 from mutext import cli
 from mutext_grader import GradingError, cli_grade, grade
+from mutext_grader import cli as grade_cli
 from mutext_grader import ex01_two_mass_hinf as ex01
 from mutext.grading.sandbox import _Events
 from mutext_grader.solutions import ex01_two_mass_hinf as sol
 
-ROOT = Path(__file__).resolve().parents[1]
-SUBS = Path(__file__).resolve().parent / "grading_submissions"
 EXERCISE = "ex01_two_mass_hinf"
 LOOP_LIMIT = 8.0   # seconds per question for the endless-loop submission
+SEED = 20240611
 
-SUBMISSIONS = {
-    "reference": ROOT / "instructor" / "mutext_grader" / "solutions" / "ex01_two_mass_hinf.py",
-    "stub": ROOT / "exercises" / "ex01_two_mass_hinf.py",
-    # ex01 submissions have no exNN_ prefix; the other exercises' submissions do
-    **{p.stem: p for p in SUBS.glob("*.py") if not re.match(r"ex\d\d_", p.stem)},
-}
-
-_pool = ThreadPoolExecutor(max_workers=2)
-_futures = {}
-_lock = threading.Lock()
-
-
-def _grade(name):
-    limit = LOOP_LIMIT if name == "infinite_loop" else 60.0
-    t0 = time.perf_counter()
-    rep = grade(EXERCISE, SUBMISSIONS[name], time_limit=limit)
-    return rep, time.perf_counter() - t0
-
-
-def graded(name):
-    """Report of a submission; the first call starts grading all of them in the background."""
-    with _lock:
-        if not _futures:
-            # slowest first, so the pool finishes early
-            for n in sorted(SUBMISSIONS, key=lambda n: (n != "infinite_loop", n != "reference")):
-                _futures[n] = _pool.submit(_grade, n)
-    return _futures[name].result()[0]
-
-
-def q(report, qid):
-    return next(x for x in report.questions if x.id == qid)
-
-
-def full(report, *qids):
-    return all(q(report, i).score == q(report, i).max_score for i in qids)
+# ex01 submissions have no exNN_ prefix; the other exercises' submissions do
+graded = Submissions(EXERCISE, SEED, extra={p.stem: p for p in SUBS.glob("*.py") if not re.match(r"ex\d\d_", p.stem)},
+                     confined=("infinite_loop", "reference", "cheat_at_import", "cheat_in_functions", "wrong_types"),
+                     time_limits={"infinite_loop": LOOP_LIMIT})
+SUBMISSIONS = graded.paths
+#: graded in this process by default, confined with -m slow
+HERE = ("destabilizing", "missing_noise", "one_exception", "stub", "syntax_error", "wrong_weight")
+@pytest.fixture
+def cli_in_process(monkeypatch):
+    """``mutext grade FILE --seed SEED`` grading through the harness: the run of a test here on that file
+    (its functions run in this process); everything else the command line does is its own."""
+    monkeypatch.setattr(grade_cli, "grade", memoised_grade(here=True))
 
 
 # ----------------------------------------------------------------------------
@@ -73,7 +51,7 @@ def test_reference_solution_scores_full_marks():
 
 
 def test_stub_scores_zero_and_says_not_implemented():
-    rep = graded("stub")
+    rep = graded.here("stub")
     assert rep.score == 0
     for x in rep.questions:
         assert "not implemented yet" in x.output
@@ -82,7 +60,7 @@ def test_stub_scores_zero_and_says_not_implemented():
 
 
 def test_wrong_weight_loses_points_in_b_only():
-    rep = graded("wrong_weight")
+    rep = graded.here("wrong_weight")
     b = q(rep, "b")
     # z1 row wrong (f1 -> z1, u -> z1) in every call: 4 of the 6 channels that carry a signal
     assert b.score == pytest.approx(3 * 4 / 6, abs=0.01), rep.text()
@@ -93,7 +71,7 @@ def test_wrong_weight_loses_points_in_b_only():
 
 
 def test_missing_noise_channel_is_named():
-    rep = graded("missing_noise")
+    rep = graded.here("missing_noise")
     b = q(rep, "b")
     assert b.score == pytest.approx(3 * 5 / 6, abs=0.01), rep.text()
     # the same in each of the three calls: said once, without the expected value
@@ -103,7 +81,7 @@ def test_missing_noise_channel_is_named():
 
 
 def test_destabilizing_controller_scores_zero():
-    rep = graded("destabilizing")
+    rep = graded.here("destabilizing")
     d = q(rep, "d")
     assert d.score == 0
     assert "unstable" in d.output and "s = 17.86" in d.output
@@ -111,7 +89,7 @@ def test_destabilizing_controller_scores_zero():
 
 
 def test_syntax_error_scores_zero_with_line():
-    rep = graded("syntax_error")
+    rep = graded.here("syntax_error")
     assert rep.score == 0
     for x in rep.questions:
         assert "could not be imported: SyntaxError" in x.output
@@ -119,7 +97,7 @@ def test_syntax_error_scores_zero_with_line():
 
 
 def test_exception_in_one_function_others_still_scored():
-    rep = graded("one_exception")
+    rep = graded.here("one_exception")
     c = q(rep, "c")
     assert c.score == 0
     assert "ZeroDivisionError" in c.output and "in _peak" in c.output
@@ -128,19 +106,14 @@ def test_exception_in_one_function_others_still_scored():
 
 
 def test_infinite_loop_hits_time_limit_and_rest_is_graded():
-    rep, seconds = _futures_result("infinite_loop")
+    rep = graded("infinite_loop")
     c = q(rep, "c")
     assert c.score == 0 and c.status == "timeout"
     assert f"time limit of {LOOP_LIMIT:g} s exceeded" in c.output
     assert "first-order low-pass" in c.output   # names the input it was stuck on
     # (d) runs after (c) in a fresh child process
     assert full(rep, "a", "b", "d")
-    assert seconds < LOOP_LIMIT + 40
-
-
-def _futures_result(name):
-    graded(name)
-    return _futures[name].result()
+    assert rep.seconds < LOOP_LIMIT + 40
 
 
 def test_wrong_types_and_shapes_are_reported():
@@ -167,6 +140,13 @@ def test_reading_the_reference_is_blocked_and_reported():
     assert "importing mutext_grader" in c.output
     assert all(x.status == "violation" for x in (a, b, c))
     assert full(rep, "d")
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("name", HERE)
+def test_confined_run_agrees_with_the_run_in_process(name):
+    """What the default run checks on the functions run in this process holds for the confined run."""
+    assert_same_scores_and_feedback(graded(name), graded.here(name))
 
 
 def test_module_level_violation_zeroes_everything():
@@ -255,9 +235,9 @@ def test_reference_solution_agrees_with_the_library():
 # command line and results.json
 # ----------------------------------------------------------------------------
 
-def test_json_output_has_gradescope_schema(tmp_path, capsys):
+def test_json_output_has_gradescope_schema(tmp_path, capsys, cli_in_process):
     out = tmp_path / "results.json"
-    code = cli_grade([EXERCISE, str(SUBMISSIONS["one_exception"]), "--output", str(out)])
+    code = cli_grade([EXERCISE, str(SUBMISSIONS["one_exception"]), "--output", str(out), "--seed", str(SEED)])
     assert code == 0
     printed = capsys.readouterr().out
     assert "Total: 8.00 / 10" in printed
@@ -270,10 +250,11 @@ def test_json_output_has_gradescope_schema(tmp_path, capsys):
         assert isinstance(t["name"], str) and isinstance(t["output"], str)
     assert sum(t["score"] for t in data["tests"]) == data["score"]
     assert "ZeroDivisionError" in data["tests"][2]["output"]
+    assert data == json.loads(json.dumps(graded.here("one_exception").to_gradescope()))   # the run the tests share
 
 
-def test_json_to_stdout(capsys):
-    code = cli_grade(["ex01", str(SUBMISSIONS["syntax_error"]), "--json"])
+def test_json_to_stdout(capsys, cli_in_process):
+    code = cli_grade(["ex01", str(SUBMISSIONS["syntax_error"]), "--json", "--seed", str(SEED)])
     assert code == 0
     data = json.loads(capsys.readouterr().out)
     assert data["score"] == 0.0 and [t["max_score"] for t in data["tests"]] == [2.0, 3.0, 2.0, 3.0]
