@@ -211,14 +211,20 @@ def dk_iteration(P, structure: BlockStructure, nmeas: int, ncon: int, *, omega=N
     Examples
     --------
     Robust performance of the thesis's two-mass problem with the bound on
-    :math:`x_1` at 0.043 m and +/-2 % on every parameter, on half the default
-    grids (a few seconds):
+    :math:`x_1` at 0.043 m and +/-2 % on every parameter: two K steps on a
+    coarse grid of 12 frequencies, the real parameters bounded as complex ones
+    (``dg=False``; about a second).  The first, H-infinity, controller leaves
+    :math:`\mu` at 3.03; the second, with the fitted D scalings, brings it
+    below 1 (the defaults, eight iterations on 80 points and the D-G bound,
+    reach 0.984 with 16 states in about 10 s):
 
     >>> from mutext.examples import two_mass_uncertain as tmu
-    >>> res = dk_iteration(tmu.plant(0.043), tmu.structure(), 1, 1, grid_points=40, final_points=100)
-    >>> bool(res.mu_upper < 1), bool(res.mu_lower <= res.mu_upper)
-    (True, True)
-    >>> res.controller_order <= tmu.plant(0.043).nstates + 12
+    >>> P = tmu.plant(0.043)
+    >>> res = dk_iteration(P, tmu.structure(), 1, 1, max_iter=2, grid_points=12, final_points=12,
+    ...                    dg=False)
+    >>> round(res.history[0]["mu"], 2), bool(res.mu_upper < 1), bool(res.mu_lower <= res.mu_upper)
+    (3.03, True, True)
+    >>> res.controller_order <= P.nstates + 12
     True
     """
     t0 = time.perf_counter()

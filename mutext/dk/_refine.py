@@ -130,15 +130,16 @@ def refine_controller(P, structure: BlockStructure, K, nmeas: int, ncon: int, *,
 
     Examples
     --------
-    Two steps on the first D-K controller (the H-infinity one) of the two-mass problem at
-    0.043 m (about 10 s):
+    Two steps on the first D-K controller (the H-infinity one, 6 states) of the distillation
+    column, whose blocks are complex (no G scalings; about 2 s, most of it the analyses of the
+    fine grid before and after): the peak falls from 1.181 to 1.180, the order stays.
 
     >>> from mutext.dk import dk_iteration
-    >>> from mutext.examples import two_mass_uncertain as tmu
-    >>> P = tmu.plant(0.043)
-    >>> dkr = dk_iteration(P, tmu.structure(), 1, 1, max_iter=1)
-    >>> ref = refine_controller(P, tmu.structure(), dkr.K, 1, 1, max_steps=2)
-    >>> bool(ref.mu_upper_dg <= dkr.mu_upper_dg + 1e-9), ref.K.nstates == dkr.K.nstates
+    >>> from mutext.examples import distillation
+    >>> P, S = distillation.plant(), distillation.structure()
+    >>> dkr = dk_iteration(P, S, 2, 2, max_iter=1, grid_points=12, final_points=12)
+    >>> ref = refine_controller(P, S, dkr.K, 2, 2, max_steps=2)
+    >>> bool(ref.mu_upper_dg < dkr.mu_upper_dg), ref.K.nstates == dkr.K.nstates
     (True, True)
     """
     t0 = time.perf_counter()
