@@ -34,8 +34,14 @@ def sweep(model, seed=3, noise=NOISE):
     return measure_rotor(model, "i12", "x13", noise=noise, rng=seed)
 
 
-def test_breathing_crack_shows_once_per_revolution_sidebands(modes):
-    ev = sideband_evidence(sweep(crack("mayes")), modes, SPEED_HZ)
+@pytest.fixture(scope="module")
+def mayes_sweep():
+    """The sweep of the rotor with a breathing (mayes) crack, seed 3 (read-only for the tests)."""
+    return sweep(crack("mayes"))
+
+
+def test_breathing_crack_shows_once_per_revolution_sidebands(modes, mayes_sweep):
+    ev = sideband_evidence(mayes_sweep, modes, SPEED_HZ)
     assert ev.verdict == "once per revolution"
     found = {(round(c.mode_hz), c.k): c for c in ev.found()}
     # the first mode's k = +-1 sidebands, at f_n -+ 10 Hz, where predicted
@@ -79,7 +85,32 @@ def test_bad_input(modes):
         sideband_evidence(d, modes, SPEED_HZ, alpha=2.0)
 
 
+def test_diagnose_reports_the_sidebands_of_data_taken_at_speed(mayes_sweep):
+    # the at-speed path of diagnose on the thesis rotor, without the breathing-crack fit (the slow
+    # test_diagnose_reports_sidebands_for_data_taken_at_speed fits it): no crack among the hypotheses, so
+    # no turning crack is fitted, and the sidebands are reported as what no time-invariant hypothesis holds
+    from mutext.diagnose import diagnose
+    from mutext.report import _html
+    res = diagnose(data_path("rotor.toml"), [mayes_sweep], refit=1,
+                   only=lambda h: h.kind == "stiffness" and h.station == 15)
+    assert res.n_hypotheses == 1
+    assert res.sidebands["verdict"] == "once per revolution" and res.sidebands["orders_found"] == [1]
+    assert res.breathing is None
+    assert any("the data show sidebands (once per revolution): the rotor is time-periodic" in n
+               for n in res.notes), res.notes
+    assert "sidebands" in res.report() and res.as_dict()["sidebands"]["orders_found"]
+    lines = res.at_speed_lines()
+    assert lines and "once per revolution" in lines[0]
+    page = _html(res, [])
+    assert "<h2>At speed</h2>" in page and "once per revolution" in page
+    assert "crack turning with the shaft" not in page
+
+
+@pytest.mark.slow
 def test_diagnose_reports_sidebands_for_data_taken_at_speed():
+    # about 25 CPU-s (the breathing-crack fit); the at-speed report path is in the default run by
+    # test_diagnose_reports_the_sidebands_of_data_taken_at_speed (sideband evidence and the 'At speed'
+    # section from a diagnosis with the hypotheses restricted, no crack fitted)
     # a breathing crack: the diagnosis names the crack's place and the sidebands say it breathes
     from mutext.diagnose import diagnose
     d = sweep(crack("mayes"), seed=5, noise=1e-3)
