@@ -15,6 +15,8 @@ submission and one that only borrows the reference (all 0), and wrong uploads
 (``--require-isolation``) on its own, and what the zip holds: only files git
 tracks (no ``diagnosis/`` of the quick start), a fresh or a given secret.
 """
+import copy
+import dataclasses
 import json
 import os
 import re
@@ -38,28 +40,38 @@ import make_autograder  # noqa: E402
 HOSTILE = ROOT / "tests" / "grading_submissions" / "hostile"
 SOLUTION = ROOT / "instructor" / "mutext_grader" / "solutions" / "ex03_free_decay.py"
 IS_ROOT = hasattr(os, "geteuid") and os.geteuid() == 0
+SEED = 20250611
 
 
 def _not_isolated(monkeypatch):
-    """Make every run report isolation "none", as on a laptop without Landlock."""
+    """Make every run report isolation "none", as on a laptop without Landlock.  The confined run of a
+    file on the same inputs is made once: the runs of the course-mode test differ only in what the
+    grader does with the report."""
     real = core.run_submission
+    runs = {}
 
-    def run(*args, **kwargs):
-        res = real(*args, **kwargs)
+    def run(submission, jobs, **kwargs):
+        key = (str(submission), json.dumps([dataclasses.asdict(j) for j in jobs]), repr(sorted(kwargs.items())))
+        if key not in runs:
+            runs[key] = real(submission, jobs, **kwargs)
+        res = copy.deepcopy(runs[key])
         res.isolation = "none"
         return res
     monkeypatch.setattr(core, "run_submission", run)
+    return runs
 
 
 def test_course_mode_scores_an_unisolated_run_zero(monkeypatch, tmp_path, capsys):
-    _not_isolated(monkeypatch)
-    relaxed = core.grade("ex03_free_decay", SOLUTION)
+    runs = _not_isolated(monkeypatch)
+    relaxed = core.grade("ex03_free_decay", SOLUTION, seed=SEED)
     assert relaxed.score == relaxed.max_score == 10      # the same run, not required: full marks
-    strict = core.grade("ex03_free_decay", SOLUTION, require_isolation=True)
+    strict = core.grade("ex03_free_decay", SOLUTION, require_isolation=True, seed=SEED)
     assert strict.score == 0 and strict.max_score == 10
     assert all("not isolated" in q.output for q in strict.questions)
     out = tmp_path / "results.json"
-    assert grade_main(["ex03", str(SOLUTION), "--require-isolation", "--output", str(out)]) == NOT_ISOLATED
+    assert grade_main(["ex03", str(SOLUTION), "--require-isolation", "--output", str(out),
+                       "--seed", str(SEED)]) == NOT_ISOLATED
+    assert len(runs) == 1                                # one confined run behind the three reports
     data = json.loads(out.read_text())
     assert data["score"] == 0 and data["isolation"] == "none"
     assert "isolation was required" in data["output"]

@@ -1,6 +1,7 @@
 """What a submission writes cannot reach a terminal as control characters nor pose as the grader's lines.
 
-The submissions in ``tests/grading_submissions/reports/`` fail with error
+The submissions in ``tests/grading_submissions/reports/`` (graded once, in a class directory under
+names that are spreadsheet formulas and escape sequences themselves) fail with error
 messages (and make the grader quote a module name and a line of error output)
 that carry terminal escape sequences, carriage returns, other C0/C1 and
 bidirectional control characters and fake ``Total: 10.00 / 10`` lines.  The
@@ -14,7 +15,6 @@ import json
 import re
 import shutil
 import unicodedata
-from concurrent.futures import ThreadPoolExecutor
 from pathlib import Path
 
 import pytest
@@ -51,10 +51,11 @@ def _bad(text):
 
 
 @pytest.fixture(scope="module")
-def reports():
-    with ThreadPoolExecutor(max_workers=3) as pool:
-        done = {p.name: pool.submit(grade, "ex03_free_decay", p, time_limit=30, seed=7) for p in HOSTILE}
-        return {name: f.result() for name, f in done.items()}
+def reports(batch):
+    """The reports of the hostile files, as the class batch below graded them (under the names of
+    ``NAMES``; each file is graded once in this module)."""
+    _res, _seen, _d, made = batch
+    return {NAMES[name].name: rep for name, rep in made if NAMES[name] in HOSTILE}
 
 
 def test_the_hostile_submissions_are_there_and_score_zero(reports):
@@ -144,16 +145,25 @@ NAMES = {
 
 @pytest.fixture(scope="module")
 def batch(tmp_path_factory):
+    """The class directory graded once (one job, so in this process): the batch's result, its progress
+    lines, the directory and the reports the batch made."""
     d = tmp_path_factory.mktemp("class")
     for name, src in NAMES.items():
         shutil.copyfile(src, d / name)
-    seen = []
-    res = gbatch.grade_batch("ex03_free_decay", d, jobs=1, time_limit=30, progress=lambda s, f: seen.append(s))
-    return res, seen, d
+    seen, made = [], []
+
+    def keep(exercise, path, *args, **kwargs):
+        made.append((Path(path).name, grade(exercise, path, *args, **kwargs)))
+        return made[-1][1]
+    with pytest.MonkeyPatch.context() as mp:
+        mp.setattr(gbatch, "grade", keep)
+        res = gbatch.grade_batch("ex03_free_decay", d, jobs=1, time_limit=30, progress=lambda s, f: seen.append(s))
+    assert len(made) == len(NAMES)
+    return res, seen, d, made
 
 
 def test_summary_csv_quotes_formulas_and_holds_no_control_characters(batch):
-    res, _seen, d = batch
+    res, _seen, d, _made = batch
     raw = (d / "results" / "summary.csv").read_text(encoding="utf-8")
     assert _bad(raw.replace("\r\n", "\n")) == []
     with open(d / "results" / "summary.csv", newline="", encoding="utf-8") as fh:
@@ -170,7 +180,7 @@ def test_summary_csv_quotes_formulas_and_holds_no_control_characters(batch):
 
 
 def test_results_files_keep_the_exact_name_and_clean_texts(batch):
-    res, _seen, d = batch
+    res, _seen, d, _made = batch
     for r in res.rows:
         data = json.loads(Path(r["results"]).read_text(encoding="utf-8"))
         assert data["extra_data"]["submission"] == r["submission"]        # exact (JSON is not interpreted)
@@ -180,7 +190,7 @@ def test_results_files_keep_the_exact_name_and_clean_texts(batch):
 
 
 def test_table_and_progress_lines_are_clean(batch):
-    res, seen, _d = batch
+    res, seen, _d, _made = batch
     table = _table(res)
     assert _bad(table) == [] and all(_bad(s) == [] for s in seen)
     lines = table.split("\n")
