@@ -289,6 +289,29 @@ def rotor_from_table(table: StationTable, *, poisson_ratio: float | None = DEFAU
     translational input -> force ``F<s>`` [N], translational output ->
     displacement ``x<s>`` [m], rotational input -> moment ``M<s>`` [N m]
     about y, rotational output -> rotation ``psi<s>`` [rad].
+
+    Parameters
+    ----------
+    table : StationTable
+        Station rows in SI units (lengths [m], masses [kg], inertias
+        [kg m^2], modulus [Pa], density [kg/m^3]).
+    poisson_ratio : float or None, optional
+        Poisson's ratio that gives the shear modulus G = E / (2 (1 + nu))
+        (shared parameter ``"nu"``); ``None`` when ``shear_modulus`` is given.
+    shear_modulus : float, optional
+        Shear modulus [Pa] (shared parameter ``"G"``), instead of ``poisson_ratio``.
+    ports_from_flags : bool, optional
+        Turn the table's input/output flags into ports (above).
+    extra_elements : sequence of Element, optional
+        Bearings, exciters, cracks or other elements added to the shaft and disks.
+    inputs, outputs : sequence of InputPort / OutputPort, optional
+        Ports added to those of the flags.
+    **rotor_kw
+        Passed to :class:`Rotor` (e.g. ``speed``, ``damping``, ``name``).
+
+    Returns
+    -------
+    Rotor
     """
     st = table.stations
     if (poisson_ratio is None) == (shear_modulus is None):
@@ -688,7 +711,45 @@ def _impedance(ctx: _Ctx, t, where: str, node: dict) -> Impedance:
 # ---------------------------------------------------------------------------
 
 def loads_model(text: str, *, source: str = "<string>", base_dir: str = ".", station_table=None):
-    """Build a model from TOML text (see the module docstring)."""
+    """Build a model from TOML text (see the module docstring).
+
+    Parameters
+    ----------
+    text : str
+        The model file's contents (TOML): a rotor (``[shaft]`` or
+        ``[[station]]`` tables) or a lumped chain (``[[mass]]`` tables).
+    source : str, optional
+        Name of the text in error messages (a file name).
+    base_dir : str, optional
+        Directory against which a station-table path in the text is resolved.
+    station_table : str, path-like or StationTable, optional
+        Use this station table instead of the one the text names.
+
+    Returns
+    -------
+    Rotor or Structure
+
+    Raises
+    ------
+    ModelError
+        Invalid TOML, or a table or field that breaks the format's rules
+        (named with its table and key).
+
+    Examples
+    --------
+    >>> from mutext.rotor import loads_model
+    >>> chain = loads_model('''
+    ... [[mass]]
+    ... name = "m1"
+    ... mass = 1.0
+    ... [[spring]]
+    ... name = "k1"
+    ... between = ["m1", "ground"]
+    ... stiffness = 100.0
+    ... ''')
+    >>> chain.natural_frequencies().round(4)            # sqrt(100 / 1) / 2 pi Hz
+    array([1.5915])
+    """
     try:
         doc = tomllib.loads(text)
     except tomllib.TOMLDecodeError as exc:
