@@ -16,6 +16,7 @@ confined runs of the reference, the stub and the cheating, crashing and hostile 
 ``tests/grading_submissions/<prefix>_*.py``) on the seed of a test module: ``graded(name)`` confined,
 ``graded.here(name)`` in process.
 """
+import dataclasses
 import importlib.util
 import json
 import threading
@@ -130,6 +131,20 @@ _grade_here = types.FunctionType(core.grade.__code__, {**core.grade.__globals__,
 _grade_here.__kwdefaults__ = core.grade.__kwdefaults__
 _here = {}
 _here_lock = threading.Lock()
+
+
+def _without_warm_up(name):
+    return dataclasses.replace(get_exercise(name), prepare=None)
+
+
+#: :func:`mutext_grader.grade`, the same code, without the warm-up thread of the exercise's reference
+#: computations (``Exercise.prepare``, only started early so that they overlap with the child's run: the
+#: checks compute what they need either way).  For files that mostly fail before any check, such as the
+#: hostile submissions: ex08's warm-up alone is a D-K search of several CPU-seconds.
+grade_without_warm_up = types.FunctionType(core.grade.__code__,
+                                           {**core.grade.__globals__, "get_exercise": _without_warm_up},
+                                           "grade_without_warm_up", core.grade.__defaults__, core.grade.__closure__)
+grade_without_warm_up.__kwdefaults__ = core.grade.__kwdefaults__
 
 
 def graded_here(exercise, path, seed):
