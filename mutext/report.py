@@ -14,7 +14,7 @@ from ._mpl import db as _db, pyplot as _plt, save as _save
 from .diagnose import Diagnosis, write_model
 from .jsonio import to_json as _to_json
 
-__all__ = ["write_diagnosis", "to_json", "diagnosis_figures", "mbi_lines"]
+__all__ = ["write_diagnosis", "diagnosis_json", "diagnosis_figures", "mbi_lines"]
 
 
 
@@ -22,7 +22,7 @@ __all__ = ["write_diagnosis", "to_json", "diagnosis_figures", "mbi_lines"]
 RANKED = 12
 
 
-def to_json(result: Diagnosis) -> str:
+def diagnosis_json(result: Diagnosis) -> str:
     """The diagnosis as one JSON object (non-finite numbers as strings ``"inf"``, ``"nan"``).
 
     Parameters
@@ -64,7 +64,7 @@ def write_diagnosis(result: Diagnosis, out_dir) -> dict:
     paths["figures"] = figs
     jpath = os.path.join(out_dir, "diagnosis.json")
     with open(jpath, "w", encoding="utf-8") as fh:
-        fh.write(to_json(result))
+        fh.write(diagnosis_json(result))
     paths["json"] = jpath
     hpath = os.path.join(out_dir, "report.html")
     with open(hpath, "w", encoding="utf-8") as fh:

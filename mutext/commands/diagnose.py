@@ -105,7 +105,7 @@ def run(args) -> int:
     from ..diagnose import diagnose
     from ..errors import ModelError
     from ..progress import ProgressLine
-    from ..report import mbi_lines, to_json, write_diagnosis
+    from ..report import diagnosis_json, mbi_lines, write_diagnosis
     from ..rig import read_frfs
     prog = ProgressLine(enabled=not args.quiet)
     if args.batch:
@@ -122,7 +122,7 @@ def run(args) -> int:
         prog("writing the report", 1.0)
         write_diagnosis(res, args.out)
     if args.json:
-        print(to_json(res))
+        print(diagnosis_json(res))
     else:
         print(res.report())
         for line in mbi_lines(res):

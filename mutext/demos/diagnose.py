@@ -55,7 +55,7 @@ def run(args) -> int:
         from .._files import output_directory
         output_directory(args.out, "--out")     # checked before the work, not after it
     from ..progress import ProgressLine
-    from ..report import to_json, write_diagnosis
+    from ..report import diagnosis_json, write_diagnosis
     out = args.out or tempfile.mkdtemp(prefix="mutext-diagnose-")
     case = hidden_effect_data(args.example, seed=args.seed, kind=args.kind, noise=args.noise,
                               out_dir=os.path.join(out, "case"))
@@ -73,7 +73,7 @@ def run(args) -> int:
     right = (v.kind, v.station) == (key["kind"], key["station"])
     if args.json:
         import json
-        obj = json.loads(to_json(d))
+        obj = json.loads(diagnosis_json(d))
         obj["answer_key"] = key
         obj["found"] = right
         print(json.dumps(obj))
