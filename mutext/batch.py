@@ -33,6 +33,7 @@ import time
 import traceback
 from pathlib import Path
 
+from ._validation import AnyOf, Integer, check_param
 from .errors import ModelError
 
 __all__ = ["SUMMARY_FIELDS", "check_jobs", "dask_backend", "diagnose_batch", "find_data_sets", "run_parallel"]
@@ -116,9 +117,7 @@ def check_jobs(jobs, what: str = "batch") -> int:
     what : str, optional
         Name of the caller in the error message.
     """
-    if isinstance(jobs, bool) or not isinstance(jobs, int) or jobs == 0:
-        raise ModelError(f"{what}: jobs must be a positive number of workers or -1, got {jobs!r}")
-    return jobs
+    return int(check_param(what, "jobs (the number of workers)", jobs, AnyOf(Integer(lo=1), Integer(hi=-1))))
 
 
 def run_parallel(fn, tasks, *, jobs: int = 1, progress=None, describe=None):

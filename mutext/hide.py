@@ -55,6 +55,7 @@ from pathlib import Path
 
 import numpy as np
 
+from ._validation import Integer, validate_params
 from .errors import ModelError
 from .response import frequency_grid
 from .rig import Noise, measure, write_frf
@@ -447,6 +448,7 @@ def _case_rotor(path, seed, kind, noise, rng):
 # the entry point
 # ----------------------------------------------------------------------------
 
+@validate_params({"seed": Integer(lo=0)})
 def hidden_effect_data(example: str = "three_mass", seed: int = 0, *, kind: str | None = None,
                        noise: float = 0.01, out_dir=None) -> HiddenCase:
     """A data set with a hidden effect (see the module docstring).
@@ -477,8 +479,6 @@ def hidden_effect_data(example: str = "three_mass", seed: int = 0, *, kind: str 
         raise ModelError(f"hide: no example or model file '{example}' (examples: {', '.join(EXAMPLES)})")
     if not (isinstance(noise, (int, float)) and 0 < noise <= 0.2):
         raise ModelError(f"hide: noise must be a relative level in (0, 0.2], got {noise!r}")
-    if isinstance(seed, bool) or not isinstance(seed, (int, np.integer)) or seed < 0:
-        raise ModelError(f"hide: seed must be a non-negative integer, got {seed!r}")
     try:
         with open(path, "rb") as fh:
             doc = tomllib.load(fh)

@@ -25,6 +25,7 @@ from typing import Mapping, Sequence
 import control as ct
 import numpy as np
 
+from ._validation import Real, validate_params
 from .errors import IllPosedError, ModelError
 
 __all__ = [
@@ -969,6 +970,7 @@ def _axis_tolerance(A: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     return lam, np.maximum(1e-12 * np.abs(lam), 10 * np.finfo(float).eps * np.linalg.norm(A, 1))
 
 
+@validate_params({"rtol": Real(0, 1, closed="neither")})
 def hinf_norm(sys, rtol: float = 1e-10, *, require_stable: bool = True) -> HinfNorm:
     r"""H-infinity norm :math:`\sup_\omega \bar\sigma(G(j\omega))` of a continuous-time system.
 
@@ -1006,8 +1008,6 @@ def hinf_norm(sys, rtol: float = 1e-10, *, require_stable: bool = True) -> HinfN
     >>> round(r.value, 3), round(r.frequency, 3)       # the resonance peak 1/(2 zeta sqrt(1 - zeta^2))
     (5.025, 0.99)
     """
-    if not is_real_number(rtol) or not np.isfinite(rtol) or not 0 < rtol < 1:
-        raise ModelError(f"hinf_norm: rtol must be a number between 0 and 1 (exclusive), got {rtol!r}")
     sys = as_ss(sys)
     check_finite(sys)
     B0, C0, D0 = (np.asarray(X, float) for X in (sys.B, sys.C, sys.D))

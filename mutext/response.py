@@ -32,6 +32,7 @@ from pathlib import Path
 
 import numpy as np
 
+from ._validation import Integer, Options, Real, validate_params
 from .errors import ModelError
 
 __all__ = ["FRF", "FRFFileError", "FRFMatrix", "sweep_frequencies", "frequency_grid", "local_extrema",
@@ -327,6 +328,8 @@ def local_extrema(freq_hz, magnitude):
     return f[mx], f[mn]
 
 
+@validate_params({"start": Real(lo=0, closed="neither"), "stop": Real(lo=0, closed="neither"),
+                  "step": Real(lo=0, closed="neither")})
 def sweep_frequencies(start: float = 20.0, stop: float = 225.0, step: float = 0.5) -> np.ndarray:
     """Linear sine-sweep frequencies [Hz]: ``start, start+step, ...`` up to ``stop`` inclusive.
 
@@ -357,9 +360,7 @@ def sweep_frequencies(start: float = 20.0, stop: float = 225.0, step: float = 0.
     array([0.1, 0.2, 0.3])
     """
     start, stop, step = float(start), float(stop), float(step)
-    if not (math.isfinite(start) and math.isfinite(stop) and math.isfinite(step)):
-        raise ModelError("sweep_frequencies: start, stop and step must be finite")
-    if start <= 0 or step <= 0 or stop < start:
+    if stop < start:
         raise ModelError(f"sweep_frequencies: need 0 < start <= stop and step > 0 [Hz], got "
                          f"start={start}, stop={stop}, step={step}")
     n = int(math.floor((stop - start) / step + 1e-9)) + 1
@@ -367,6 +368,7 @@ def sweep_frequencies(start: float = 20.0, stop: float = 225.0, step: float = 0.
     return np.round(f, max(0, 11 - int(math.floor(math.log10(f[-1])))))
 
 
+@validate_params({"n": Integer(lo=1), "spacing": Options(("log", "linear", "step")), "avoid": Real(lo=0)})
 def frequency_grid(band=None, n: int = 400, *, poles=(), margin=(10.0, 10.0), spacing: str = "log",
                    resonance_offsets=None, avoid: float = 0.0) -> np.ndarray:
     r"""Frequencies at which to evaluate a response: a grid over a band, densified at resonances
@@ -430,12 +432,10 @@ def frequency_grid(band=None, n: int = 400, *, poles=(), margin=(10.0, 10.0), sp
             w = np.concatenate([[0.0], w])
     elif spacing == "linear":
         w = np.linspace(lo, hi, n)
-    elif spacing == "step":
+    else:                                  # "step"
         step = float(f"{(hi - lo) / n:.1g}")
         lo = math.floor(lo / step) * step
         w = np.round(lo + step * np.arange(1, int((hi - lo) / step) + 1), 10)
-    else:
-        raise ModelError(f"frequency_grid: spacing must be 'log', 'linear' or 'step', got {spacing!r}")
     if avoid > 0:
         for m in np.abs(poles[poles != 0]):
             w = w[np.abs(w / m - 1.0) > avoid]

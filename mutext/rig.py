@@ -102,6 +102,7 @@ from typing import Mapping, Sequence
 
 import numpy as np
 
+from ._validation import AnyOf, Integer, Real, check_param
 from .errors import ModelError
 from .response import DIRECTIONS, FRF, INPUT_UNITS, OUTPUT_UNITS, FRFFileError, sweep_frequencies
 from .uff import dropped_note, is_uff_file, motion_units, read_uff58, reference_units, relabel, units_hint
@@ -791,17 +792,13 @@ def measure_rotor(model, in_port: str, out_port: str, freq_hz=None, *, noise=Non
     if combination is not None:
         orders = []
         for k in combination:
-            if isinstance(k, bool) or not isinstance(k, (int, np.integer)) or k == 0:
-                raise ModelError(f"measure_rotor: combination orders must be non-zero integers (k of "
-                                 f"f + k F), got {k!r}")
-            orders.append(int(k))
+            orders.append(int(check_param("measure_rotor", "a combination order (k of f + k F)", k,
+                                          AnyOf(Integer(hi=-1), Integer(lo=1)))))
         if not orders or len(set(orders)) != len(orders):
             raise ModelError(f"measure_rotor: combination must list distinct non-zero orders, got {combination!r}")
     speed = None
     if speed_hz is not None:
-        if isinstance(speed_hz, bool) or not isinstance(speed_hz, (int, float)) or not (
-                math.isfinite(speed_hz) and speed_hz >= 0):
-            raise ModelError(f"measure_rotor: speed_hz must be a running speed >= 0 [Hz], got {speed_hz!r}")
+        check_param("measure_rotor", "speed_hz (the running speed [Hz])", speed_hz, Real(lo=0))
         speed = 2.0 * math.pi * float(speed_hz)
     if planes not in ("x", "xy"):
         raise ModelError(f"measure_rotor: planes must be 'x' (one channel) or 'xy' (the planar 2 x 2 "

@@ -37,12 +37,14 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ._validation import Real, validate_params
 from .errors import ModelError
 
 __all__ = ["simulate_free_decay", "decay_peaks", "DecayEstimate", "decay_estimate", "CartParameters",
            "cart_parameters", "damper_coefficient", "identify_three_mass"]
 
 
+@validate_params({"m": Real(lo=0, closed="neither"), "k": Real(lo=0, closed="neither"), "c": Real(lo=0)})
 def simulate_free_decay(m: float, k: float, c: float, x0: float = 0.025, duration: float = 3.0,
                         fs: float = 1000.0, noise: float = 0.0, rng=None):
     """Sampled free decay of ``m x'' + c x' + k x = 0`` from rest at ``x0`` (m).
@@ -77,11 +79,6 @@ def simulate_free_decay(m: float, k: float, c: float, x0: float = 0.025, duratio
     >>> round(est.omega_n, 2), round(est.zeta_exact, 4)
     (20.0, 0.02)
     """
-    for name, v in (("m", m), ("k", k)):
-        if not v > 0:
-            raise ModelError(f"free decay: {name} must be positive, got {v}")
-    if c < 0:
-        raise ModelError(f"free decay: c must be non-negative, got {c}")
     wn = np.sqrt(k / m)
     z = c / (2.0 * np.sqrt(k * m))
     if z >= 1:

@@ -110,6 +110,7 @@ from pathlib import Path
 
 import numpy as np
 
+from ._validation import Options, validate_params
 from .errors import ModelError
 from .response import FRF, FRFFileError
 
@@ -814,6 +815,7 @@ def _fmt13(v: float) -> float:
     return float(f"{v:13.5e}")
 
 
+@validate_params({"ordinate": Options(("displacement", "velocity", "acceleration"))})
 def write_uff58(path, frfs, *, ordinate: str = "displacement", binary: bool = False, mapping=None) -> Path:
     r"""Write FRFs as Universal File data sets 58 (one per FRF, function type 4), through ``pyuff``.
 
@@ -868,8 +870,6 @@ def write_uff58(path, frfs, *, ordinate: str = "displacement", binary: bool = Fa
     frfs = list(frfs)
     if not frfs:
         raise ModelError(f"write_uff58 {path}: no FRF to write")
-    if ordinate not in _TYPE_CODE:
-        raise ModelError(f"write_uff58 {path}: ordinate must be one of {', '.join(_TYPE_CODE)}, got {ordinate!r}")
     node_of = None
     if mapping is not None:
         node_of = {}

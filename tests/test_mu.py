@@ -430,7 +430,7 @@ def test_bad_blocks():
         Block("scalar", 2, 3)
     with pytest.raises(ModelError, match="must be square"):
         Block("real", 1, 2)
-    with pytest.raises(ModelError, match="positive integer"):
+    with pytest.raises(ModelError, match="rows must be an integer >= 1"):
         Block.full(0)
     with pytest.raises(ModelError, match="kind"):
         Block("diagonal", 2, 2)

@@ -19,7 +19,6 @@ but not required (on a laptop without Landlock the check still runs).
 """
 from __future__ import annotations
 
-import math
 import re
 import secrets
 import time
@@ -28,6 +27,7 @@ from pathlib import Path
 
 import numpy as np
 
+from .._validation import Integer, NoneOr, Real, validate_params
 from ..errors import MutextError
 from .sandbox import Job, SandboxError, run_submission
 from .spec import EXERCISES, UnknownExercise, get_exercise
@@ -268,12 +268,7 @@ def _function_check(q, calls, outcome) -> FunctionCheck:
     return fc
 
 
-def _time_limit(value) -> float:
-    if isinstance(value, bool) or not isinstance(value, (int, float)) or not math.isfinite(value) or value <= 0:
-        raise CheckError(f"the time limit must be a positive number of seconds, got {value!r}")
-    return float(value)
-
-
+@validate_params({"time_limit": Real(lo=0, closed="neither"), "seed": NoneOr(Integer(lo=0))}, error=CheckError)
 def check(exercise: str, path, time_limit: float = DEFAULT_TIME_LIMIT, *, seed: int | None = None) -> CheckReport:
     """Run the file ``path`` on fresh sample inputs of ``exercise`` and report per function.
 
@@ -305,7 +300,7 @@ def check(exercise: str, path, time_limit: float = DEFAULT_TIME_LIMIT, *, seed: 
         ex = get_exercise(exercise)
     except UnknownExercise as exc:
         raise CheckError(str(exc)) from None
-    time_limit = _time_limit(time_limit)
+    time_limit = float(time_limit)
     p = Path(path)
     if not p.exists():
         raise CheckError(f"file not found: {path}")
@@ -315,8 +310,6 @@ def check(exercise: str, path, time_limit: float = DEFAULT_TIME_LIMIT, *, seed: 
         seed = secrets.randbits(63)
         inputs = f"sample inputs drawn afresh (seed {seed}; --seed {seed} repeats them), not the graded ones"
     else:
-        if isinstance(seed, bool) or not isinstance(seed, (int, np.integer)) or seed < 0:
-            raise CheckError(f"the seed must be a non-negative integer, got {seed!r}")
         seed = int(seed)
         inputs = f"sample inputs drawn from seed {seed}, not the graded ones"
     rng = np.random.default_rng(seed)

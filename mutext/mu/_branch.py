@@ -39,6 +39,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from .._validation import Integer, NoneOr, Real, validate_params
 from ..errors import ModelError
 from ._fast import _DGParams, _fast_at, _fast_polish
 from ._lower import mu_lower
@@ -99,6 +100,7 @@ def _box_bound(Nt, S: BlockStructure, params, x0):
     return (up2.value, x2) if up2.value < up.value else (up.value, x)
 
 
+@validate_params({"level": Real(lo=0, closed="neither")})
 def branch_certifies(M, structure, level: float, *, max_boxes: int = 2000) -> tuple[bool, int]:
     r"""Whether branch and bound proves :math:`\mu(M) <` ``level``, and the boxes it used.
 
@@ -120,8 +122,6 @@ def branch_certifies(M, structure, level: float, *, max_boxes: int = 2000) -> tu
     """
     S = _as_structure(structure)
     M = S.check(M)
-    if not (np.isfinite(level) and level > 0):
-        raise ModelError(f"level must be a positive number, got {level!r}")
     real = _real_blocks(S)
     cplx = [i for i in range(len(S.blocks)) if i not in real]
     Sc = BlockStructure([S.blocks[i] for i in cplx]) if cplx else None
@@ -168,6 +168,8 @@ def branch_certifies(M, structure, level: float, *, max_boxes: int = 2000) -> tu
     return True, used
 
 
+@validate_params({"lower": NoneOr(Real(lo=0)), "rtol": Real(0, 1, closed="neither"),
+                  "max_boxes": Integer(lo=1)})
 def mu_upper_branch(M, structure, *, lower: float | None = None, rtol: float = 1e-3,
                     max_boxes: int = 2000) -> MuBranch:
     r"""Upper bound on mixed :math:`\mu` by branch and bound on the real parameters.
@@ -208,12 +210,6 @@ def mu_upper_branch(M, structure, *, lower: float | None = None, rtol: float = 1
     """
     S = _as_structure(structure)
     M = S.check(M)
-    for name, v, ok in (("rtol", rtol, isinstance(rtol, (int, float)) and 0 < rtol < 1),
-                        ("max_boxes", max_boxes, isinstance(max_boxes, (int, np.integer))
-                         and not isinstance(max_boxes, bool) and max_boxes >= 1)):
-        if not ok:
-            raise ModelError(f"mu_upper_branch: {name} must be {'in (0, 1)' if name == 'rtol' else 'a positive integer'}, "
-                             f"got {v!r}")
     dg = mu_upper(M, S, method="fast").value
     if lower is None:
         lower = mu_lower(M, S).value
@@ -261,6 +257,7 @@ class BranchPeak:
         return float(self.value)
 
 
+@validate_params({"rtol": Real(0, 1, closed="neither"), "max_boxes": Integer(lo=1)})
 def branch_peak(Ms, structure, *, upper=None, rtol: float = 1e-3, max_boxes: int = 2000) -> BranchPeak:
     r"""Certified peak of :func:`mu_upper_branch` over a grid of matrices.
 

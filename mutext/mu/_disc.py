@@ -34,6 +34,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from .._validation import Real, validate_params
 from ..errors import ModelError
 from ._certificate import MuUpper
 from ._structure import BlockStructure, _as_structure
@@ -79,6 +80,7 @@ def _real_channels(S: BlockStructure):
     return real, [S.row_slices[k].start for k in real], [S.col_slices[k].start for k in real]
 
 
+@validate_params({"level": Real(lo=0, closed="neither")})
 def disc_transform(M, structure, centres, radii, level: float) -> np.ndarray:
     r"""The matrix :math:`M_b = (I - MC/\beta)^{-1} M R` of the disc form (module docstring).
 
@@ -117,8 +119,6 @@ def disc_transform(M, structure, centres, radii, level: float) -> np.ndarray:
     if A.ndim != 3 or A.shape[1:] != (S.ncols, S.nrows):
         raise ModelError(f"disc_transform: M must be {S.ncols} x {S.nrows} (or a stack of such), "
                          f"got shape {np.shape(M)}")
-    if not (np.isfinite(level) and level > 0):
-        raise ModelError(f"disc_transform: level must be positive and finite, got {level!r}")
     nw = A.shape[0]
     c = np.broadcast_to(np.asarray(centres, complex), (nw, len(real)))
     r = np.broadcast_to(np.asarray(radii, float), (nw, len(real)))

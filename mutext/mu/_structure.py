@@ -6,6 +6,7 @@ from typing import Sequence
 
 import numpy as np
 
+from .._validation import Integer, check_param
 from ..errors import ModelError
 
 _KINDS = ("full", "scalar", "real")
@@ -33,8 +34,7 @@ class Block:
         if self.kind not in _KINDS:
             raise ModelError(f"block kind must be one of {_KINDS}, got {self.kind!r}")
         for what, v in (("rows", self.rows), ("cols", self.cols)):
-            if isinstance(v, bool) or not isinstance(v, (int, np.integer)) or v < 1:
-                raise ModelError(f"block {self.name or self.kind}: {what} must be a positive integer, got {v!r}")
+            check_param(f"block {self.name or self.kind}", what, v, Integer(lo=1))
         if self.kind != "full" and self.rows != self.cols:
             raise ModelError(f"a repeated scalar block ({self.kind}) must be square, got {self.rows}x{self.cols}")
 

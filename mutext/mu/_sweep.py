@@ -11,6 +11,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from .._validation import Integer, validate_params
 from ..errors import IllPosedError, ModelError, SolverError
 from ._bounds import _both, _both_lower
 from ._certificate import MuUpper
@@ -225,6 +226,7 @@ def _fast_peaks(res, coords, response, S: BlockStructure, params: _DGParams, cer
         level = max(level, up.value)
 
 
+@validate_params({"npeaks": Integer(lo=0)})
 def mu_sweep(sys, structure: BlockStructure, omega=None, *, method: str = "auto", real: str = "dg",
              lower="peaks", refine: bool = True, npeaks: int = 3, rng=0, xtol: float = 1e-7,
              certify: bool = True) -> MuSweep:
@@ -319,8 +321,6 @@ def mu_sweep(sys, structure: BlockStructure, omega=None, *, method: str = "auto"
         raise ModelError(f"method must be 'auto', 'lmi', 'osborne' or 'fast', got {method!r}")
     if real not in ("dg", "complex"):
         raise ModelError(f"real must be 'dg' or 'complex', got {real!r}")
-    if not isinstance(npeaks, (int, np.integer)) or npeaks < 0:
-        raise ModelError(f"npeaks must be a non-negative integer, got {npeaks!r}")
     omega = np.unique(omega)
     if refine and omega.size >= 2:
         extra = _resonance_points(_poles(sysss), omega[0], omega[-1])

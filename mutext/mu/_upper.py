@@ -3,6 +3,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from .._validation import NoneOr, Real, validate_params
 from ..errors import ModelError, SolverError
 from ._certificate import MuUpper, _diag_result, _gevp
 from ._fast import _DGParams, _fast_default, _fast_polish
@@ -100,6 +101,7 @@ def _upper_auto(M, S: BlockStructure, use_g: bool, lower, rtol: float, nrm: floa
     return up
 
 
+@validate_params({"lower": NoneOr(Real(lo=0))})
 def mu_upper(M, structure: BlockStructure, *, method: str = "auto", real: str = "dg",
              rtol: float = 1e-6, lower: float | None = None) -> MuUpper:
     r"""Upper bound on :math:`\mu_{\boldsymbol\Delta}(M)` by D (or D-G) scaling.
@@ -167,9 +169,6 @@ def mu_upper(M, structure: BlockStructure, *, method: str = "auto", real: str = 
     structure = _as_structure(structure)
     M = structure.check(M)
     if lower is not None:
-        if isinstance(lower, (bool, np.bool_)) or not isinstance(lower, (int, float, np.integer, np.floating)) \
-                or not np.isfinite(lower) or lower < 0:
-            raise ModelError(f"lower must be a non-negative finite lower bound on mu (or None), got {lower!r}")
         cap = _norm2(M)
         if lower > cap * (1 + 1e-9):
             raise ModelError(f"lower={lower!r} cannot be a lower bound on mu: it exceeds sigma_max(M) = "

@@ -10,12 +10,12 @@ of :mod:`mutext.rotor.crack`).
 """
 from __future__ import annotations
 
-import math
 from dataclasses import dataclass
 from typing import Mapping, Sequence
 
 import casadi as ca
 
+from .._validation import AnyOf, InstanceOf, Integer, Real, check_param
 from ..errors import ModelError
 
 __all__ = ["Param", "ParameterSet", "Layout", "InputPort", "OutputPort", "Element"]
@@ -77,8 +77,7 @@ class ParameterSet:
         if not isinstance(param.name, str) or not param.name:
             raise ModelError(f"a parameter needs a non-empty name, got {param.name!r}")
         v = param.value
-        if not isinstance(v, (int, float)) or isinstance(v, bool) or not math.isfinite(v):
-            raise ModelError(f"parameter '{param.name}': nominal value must be a finite number, got {v!r}")
+        check_param(f"parameter '{param.name}'", "nominal value", v, Real())
         old = self._params.get(param.name)
         if old is not None:
             if old.value != param.value:
@@ -166,9 +165,7 @@ class Layout:
         what : str, optional
             Name of the caller in the error message.
         """
-        if isinstance(node, bool) or not isinstance(node, int) or not 1 <= node <= self.n_nodes:
-            raise ModelError(f"{what}: station/node {node!r} is outside 1..{self.n_nodes}")
-        return node
+        return int(check_param(what, "station/node", node, Integer(1, self.n_nodes)))
 
     def dof(self, node: int, label: str) -> int:
         """0-based global index of DOF ``label`` at 1-based ``node``.
@@ -284,10 +281,7 @@ class Element:
     FIELDS: dict[str, tuple[str, str]] = {}
 
     def __init__(self, nodes: Sequence[int], name: str | None = None, **values):
-        self.nodes = tuple(nodes)
-        for n in self.nodes:
-            if isinstance(n, bool) or not isinstance(n, int) or n < 1:
-                raise ModelError(f"{self.KIND}: station/node numbers are integers >= 1, got {n!r}")
+        self.nodes = tuple(int(check_param(self.KIND, "station/node number", n, Integer(lo=1))) for n in nodes)
         self.name = name if name is not None else f"{self.KIND}{self.nodes[0]}"
         self.values: dict[str, float | Param] = {}
         for f, v in values.items():
@@ -295,9 +289,7 @@ class Element:
                 raise ModelError(f"{self.name}: unknown field '{f}' (fields: {', '.join(self.FIELDS)})")
             if v is None:
                 continue
-            if not isinstance(v, Param):
-                if isinstance(v, bool) or not isinstance(v, (int, float)) or not math.isfinite(v):
-                    raise ModelError(f"{self.name}.{f}: expected a finite number or a Param, got {v!r}")
+            check_param(self.name, f, v, AnyOf(Real(), InstanceOf(Param)))
             self.values[f] = v
         self._pnames: dict[str, str] = {}
 

@@ -23,6 +23,7 @@ from typing import Sequence
 
 import numpy as np
 
+from .._validation import Integer
 from ..errors import ModelError
 from ..response import FRF
 
@@ -93,7 +94,7 @@ def _station(model, frf, which, k):
     if s is None:
         raise ModelError(f"FRF #{k}{src}: {which}_station is not set; a fitted channel needs its stations")
     n = model.layout.n_nodes
-    if isinstance(s, bool) or not isinstance(s, (int, np.integer)) or not 1 <= int(s) <= n:
+    if not Integer(1, n).is_satisfied_by(s):
         raise ModelError(f"FRF #{k}{src}: {which} station {s!r} is not in the model '{model.name}' "
                          f"(stations 1..{n})")
     return int(s)

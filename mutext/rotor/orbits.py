@@ -41,6 +41,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from .._validation import Integer, Real, check_param, validate_params
 from ..errors import ModelError
 
 __all__ = ["Ellipse", "ellipse", "Orbit", "orbit"]
@@ -167,6 +168,7 @@ class Orbit:
                 "ellipses": {int(k): self.ellipse(k).to_dict() for k in self.harmonics if k > 0}}
 
 
+@validate_params({"speed": Real(lo=0, closed="neither"), "points": Integer(lo=8)})
 def orbit(harmonics, speed: float, *, points: int = 361, label: str = "") -> Orbit:
     """The orbit over one revolution from harmonic components.
 
@@ -190,20 +192,12 @@ def orbit(harmonics, speed: float, *, points: int = 361, label: str = "") -> Orb
     >>> round(e.semi_major * 1e6, 6), round(e.semi_minor * 1e6, 6), e.direction
     (10.0, 10.0, 'forward')
     """
-    try:
-        speed = float(speed)
-    except (TypeError, ValueError):
-        raise ModelError(f"orbit: speed must be a number (rad/s), got {speed!r}") from None
-    if not (np.isfinite(speed) and speed > 0):
-        raise ModelError(f"orbit: speed must be positive and finite (rad/s), got {speed!r}")
-    if isinstance(points, bool) or not isinstance(points, (int, np.integer)) or points < 8:
-        raise ModelError(f"orbit: points must be an integer >= 8, got {points!r}")
+    speed = float(speed)
     if not isinstance(harmonics, Mapping):
         raise ModelError(f"orbit: harmonics must be a mapping order -> (X, Y), got {type(harmonics).__name__}")
     h = {}
     for k, xy in harmonics.items():
-        if isinstance(k, bool) or not isinstance(k, (int, np.integer)) or k < 0:
-            raise ModelError(f"orbit: harmonic orders are integers >= 0, got {k!r}")
+        check_param("orbit", "a harmonic order", k, Integer(lo=0))
         try:
             X, Y = (complex(v) for v in xy)
         except (TypeError, ValueError):

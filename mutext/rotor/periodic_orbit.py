@@ -39,6 +39,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from .._validation import Integer, validate_params
 from ..errors import ModelError
 from ..lti import blas_single_thread
 from .orbits import Orbit, orbit
@@ -188,6 +189,7 @@ class PeriodicResponse:
                      label=f"station {self.probes[probe][0]}, {self.speed * 30 / np.pi:.0f} rpm")
 
 
+@validate_params({"harmonics": Integer(lo=1)})
 def periodic_unbalance_response(model, speed: float, probes, *, unbalance=None, weight: bool = True,
                                 harmonics: int = 6, values=None) -> PeriodicResponse:
     """Steady response of a rotor with breathing crack(s) to weight and unbalance, all orders up to ``harmonics``.
@@ -213,8 +215,6 @@ def periodic_unbalance_response(model, speed: float, probes, *, unbalance=None, 
         raise ModelError(f"{model.name}: speed must be a number (rad/s), got {speed!r}") from None
     if not (np.isfinite(speed) and speed > 0):
         raise ModelError(f"{model.name}: the running speed must be positive and finite (rad/s), got {speed!r}")
-    if isinstance(harmonics, bool) or not isinstance(harmonics, (int, np.integer)) or harmonics < 1:
-        raise ModelError(f"harmonics must be a positive integer, got {harmonics!r}")
     pr_probes = parse_probes(model, probes)
     if not weight and unbalance is None:
         raise ModelError(f"{model.name}: nothing loads the rotor (weight=False and no unbalance)")

@@ -116,6 +116,7 @@ import control as ct
 import numpy as np
 import scipy.linalg as sla
 
+from .._validation import Integer, check_param
 from ..errors import IllPosedError, ModelError
 from ..lti import as_ss, balance_states, freqresp, hinf_norm, ss
 from ..response import frequency_grid
@@ -571,8 +572,7 @@ def balanced_truncation(model, order: int | None = None, *, max_error: float | N
         ok = np.nonzero(tails <= max_error)[0]
         order = int(ok[0]) if ok.size else n
         order = max(order, 1)
-    if isinstance(order, bool) or not isinstance(order, (int, np.integer)) or not 1 <= order <= n:
-        raise ModelError(f"order must be an integer in 1..{n} (the number of states), got {order!r}")
+    check_param(f"balanced_truncation ({n} states)", "order", order, Integer(1, n))
     order = int(order)
     s1 = hsv[:order]
     if s1[-1] <= 1e-14 * max(hsv[0], 1e-300):

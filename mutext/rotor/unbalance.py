@@ -47,6 +47,7 @@ from typing import Sequence
 
 import numpy as np
 
+from .._validation import Integer, check_param
 from ..errors import ModelError
 from ..lti import blas_single_thread
 from .analysis import _values
@@ -74,9 +75,7 @@ def parse_probes(model, probes) -> list[tuple[int, float]]:
     out = []
     for p in probes:
         st, ang = (p, 0.0) if not isinstance(p, (tuple, list)) else tuple(p) if len(p) == 2 else (None, None)
-        if isinstance(st, bool) or not isinstance(st, (int, np.integer)) or not 1 <= st <= model.layout.n_nodes:
-            raise ModelError(f"{model.name}: probe {p!r}: the station must be an integer in "
-                             f"1..{model.layout.n_nodes}")
+        check_param(f"{model.name}: probe {p!r}", "the station", st, Integer(1, model.layout.n_nodes))
         try:
             ang = float(ang)
         except (TypeError, ValueError):
@@ -105,8 +104,7 @@ def _unbalances(model, station, unbalance_kg_m, phase):
         raise ModelError(f"{model.name}: {n} unbalance station(s) but {U.size} amount(s) and {ph.size} phase(s)")
     out = []
     for s, u, p in zip(st, U, ph):
-        if isinstance(s, bool) or not isinstance(s, (int, np.integer)) or not 1 <= s <= model.layout.n_nodes:
-            raise ModelError(f"{model.name}: unbalance station {s!r} must be an integer in 1..{model.layout.n_nodes}")
+        check_param(model.name, "unbalance station", s, Integer(1, model.layout.n_nodes))
         try:
             u = float(u)
         except (TypeError, ValueError):
