@@ -18,6 +18,7 @@ confined runs of the reference, the stub and the cheating, crashing and hostile 
 """
 import dataclasses
 import importlib.util
+import inspect
 import json
 import threading
 import types
@@ -126,11 +127,26 @@ def _run_here(submission, jobs, time_limit=60.0, blocked_modules=(), **_):
 
 #: :func:`mutext_grader.grade`, the same code, with :func:`_run_here` for the confined run (a copy of the
 #: function with its own globals: grading confined in another thread at the same time is not affected)
+assert inspect.unwrap(core.grade) is core.grade
 _grade_here = types.FunctionType(core.grade.__code__, {**core.grade.__globals__, "run_submission": _run_here},
                                  "grade_here", core.grade.__defaults__, core.grade.__closure__)
 _grade_here.__kwdefaults__ = core.grade.__kwdefaults__
 _here = {}
 _here_lock = threading.Lock()
+
+
+def _check_here_function():
+    from mutext.grading import check as chk
+    real = inspect.unwrap(chk.check)         # the function under its parameter validation
+    f = types.FunctionType(real.__code__, {**real.__globals__, "run_submission": _run_here},
+                           "check_here", real.__defaults__, real.__closure__)
+    f.__kwdefaults__ = real.__kwdefaults__
+    return f
+
+
+#: :func:`mutext.grading.check.check` (``mutext check``), the same code, with :func:`_run_here` for the
+#: confined run
+check_here = _check_here_function()
 
 
 def _without_warm_up(name):

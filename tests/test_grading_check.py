@@ -3,7 +3,13 @@
 It runs the file confined on sample inputs and says per function whether it
 runs and returns the right kind and shape of value, never whether the value
 is right: no reference value may appear in what it prints.
+
+The default run checks confined the reference solution of ex03, a file without isolation, and the
+files whose functions loop, raise or import a blocked module; the stubs and the files of wrong values
+or kinds go through the same ``check`` with their functions run in this process
+(tests/grading_harness.py; confined with ``-m slow``).
 """
+import ast
 import json
 import math
 import re
@@ -13,6 +19,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
+from grading_harness import check_here
 from mutext.cli import main
 from mutext.grading.check import CheckError, check
 from mutext.grading.spec import EXERCISES, get_exercise
@@ -69,9 +76,7 @@ def test_exercise_names_and_prefixes():
 # stubs, reference solutions, wrong files
 # ----------------------------------------------------------------------------------------------------------
 
-def test_stubs_are_reported_not_implemented_per_function():
-    with ThreadPoolExecutor(max_workers=3) as pool:
-        reports = dict(zip(EXERCISES, pool.map(lambda n: check(n, STUBS / f"{n}.py", 60), EXERCISES)))
+def _assert_stubs_not_implemented(reports):
     for name, r in reports.items():
         assert r.imported and not r.ok, name
         assert [f.function for f in r.functions] == [q.function for q in EXERCISES[name].questions]
@@ -84,21 +89,51 @@ def test_stubs_are_reported_not_implemented_per_function():
         assert "not implemented" in text and "score" not in text.lower() and "point" not in text.lower()
 
 
+def test_stubs_are_reported_not_implemented_per_function():
+    """The stubs' functions run in this process; that the stubs import nothing their exercise blocks
+    (which only the confined run would see) is read from their source."""
+    _assert_stubs_not_implemented({n: check_here(n, STUBS / f"{n}.py", 60, seed=1) for n in EXERCISES})
+    for name, ex in EXERCISES.items():
+        tree = ast.parse((STUBS / f"{name}.py").read_text())
+        imported = {a.name for node in ast.walk(tree) if isinstance(node, ast.Import) for a in node.names}
+        imported |= {node.module or "" for node in ast.walk(tree) if isinstance(node, ast.ImportFrom)}
+        never = (*ex.blocked_modules, "mutext_grader", "mutext.grading", "mutext.examples", "mutext.demos")
+        blocked = [m for m in imported for b in never if m == b or m.startswith(b + ".")]
+        assert not blocked, (name, imported)
+
+
+@pytest.mark.slow
+def test_stubs_are_reported_not_implemented_per_function_confined():
+    with ThreadPoolExecutor(max_workers=3) as pool:
+        reports = dict(zip(EXERCISES, pool.map(lambda n: check(n, STUBS / f"{n}.py", 60), EXERCISES)))
+    _assert_stubs_not_implemented(reports)
+
+
 def _solution_params():
     return [pytest.param(n, marks=() if n == FAST_SOLUTION else pytest.mark.slow) for n in EXERCISES]
+
+
+def _keep_reports(monkeypatch, checker):
+    import mutext.grading.check as chk
+    made = []
+
+    def keep(*args, **kwargs):
+        made.append(checker(*args, **kwargs))
+        return made[-1]
+    monkeypatch.setattr(chk, "check", keep)
+    return made
 
 
 @pytest.fixture
 def reports(monkeypatch):
     """The reports that ``mutext check`` made (the command prints them; the test reads them too)."""
-    import mutext.grading.check as chk
-    made = []
+    return _keep_reports(monkeypatch, check)
 
-    def keep(*args, **kwargs):
-        made.append(check(*args, **kwargs))
-        return made[-1]
-    monkeypatch.setattr(chk, "check", keep)
-    return made
+
+@pytest.fixture
+def reports_here(monkeypatch):
+    """As ``reports``, with the file's functions run in this process (:func:`grading_harness.check_here`)."""
+    return _keep_reports(monkeypatch, check_here)
 
 
 @pytest.mark.parametrize("name", _solution_params())
@@ -162,11 +197,12 @@ def test_wrong_kinds_and_shapes_are_reported(tmp_path):
     (tmp_path / "wrong04.py").write_text(WRONG_EX04)
     (tmp_path / "wrong01.py").write_text(WRONG_EX01)
     (tmp_path / "wrong06.py").write_text(WRONG_EX06)
-    with ThreadPoolExecutor(max_workers=3) as pool:
-        r04 = pool.submit(check, "ex04", tmp_path / "wrong04.py", 30)
+    # wrong04's functions only return the wrong things: run in this process; the others need the child
+    # (an endless loop, a blocked import)
+    with ThreadPoolExecutor(max_workers=2) as pool:
         r01 = pool.submit(check, "ex01", tmp_path / "wrong01.py", 4)
         r06 = pool.submit(check, "ex06", tmp_path / "wrong06.py", 30)
-    r = r04.result()
+        r = check_here("ex04", tmp_path / "wrong04.py", 30)
     st = {f.function: f for f in r.functions}
     assert st["element_matrices"].status == "wrong_kind"
     assert st["element_matrices"].messages == [
@@ -238,7 +274,8 @@ def identify_cart(t_bare, y_bare, t_w, y_w, m_w):
 '''
 
 
-def test_output_holds_no_number_but_what_the_file_returned(tmp_path, capsys, reports):
+def test_output_holds_no_number_but_what_the_file_returned(tmp_path, capsys, reports_here):
+    reports = reports_here
     p = tmp_path / "values.py"
     p.write_text(RIGHT_SHAPE_WRONG_VALUES)
     code = main(["check", "ex03", str(p), "--seed", "5"])
