@@ -184,6 +184,39 @@ def memoised_grade(here=False):
     return grade_
 
 
+_drawn = {}
+_scored = {}
+
+
+def drawn(exercise, seed):
+    """``{qid: Question}`` of ``exercise`` on the inputs of ``seed`` (memoised: some draws cost seconds)."""
+    key = (get_exercise(exercise).name, int(seed))
+    if key not in _drawn:
+        _drawn[key] = {x.id: x for x in get_exercise(exercise).questions(np.random.default_rng(seed))}
+    return _drawn[key]
+
+
+def scored_here(exercise, path, seed, qids=None):
+    """``{qid: (score, feedback text)}`` of the questions ``qids`` (all by default) of ``path`` on the
+    inputs of ``seed``: its functions run in this process as in :func:`graded_here`, each question's
+    check fed directly (the feedback lines as the check gives them, not yet collapsed as in a report;
+    the questions not asked for are not run, e.g. those whose check runs a D-K search)."""
+    from mutext.grading.sandbox import Job
+    key = (*_key(exercise, path, seed, 60.0), None if qids is None else tuple(qids))
+    if key not in _scored:
+        questions = [x for x in drawn(exercise, seed).values() if qids is None or x.id in qids]
+        res = _run_here(path, [Job(x.id, x.function, x.kind, [{"args": c.args, "kwargs": c.kwargs} for c in x.calls])
+                               for x in questions])
+        if res.import_.status != "ok":
+            raise AssertionError(f"{path} could not be imported: {res.import_.error}")
+        out = {}
+        for x in questions:
+            score, fb = x.check(list(res.questions[x.id].calls))
+            out[x.id] = (score, "\n".join(fb))
+        _scored[key] = out
+    return _scored[key]
+
+
 # ----------------------------------------------------------------------------------------------------------
 # the submissions of an exercise
 # ----------------------------------------------------------------------------------------------------------

@@ -4,7 +4,6 @@ scores and feedback of the reference, the stub, common mistakes and submissions 
 The default run scores the submissions' functions in this process on one draw (the grader's checks are
 the same functions the confined run feeds); the confined runs through ``grade`` are marked slow but the
 reference's."""
-import importlib.util
 import math
 import re
 
@@ -13,67 +12,26 @@ import numpy as np
 import pytest
 
 from grading_harness import ROOT, SUBS, full, q
+from grading_harness import drawn as _drawn
+from grading_harness import scored_here
 from mutext_grader import ex07_small_gain as ex07
 from mutext_grader import grade
 from mutext_grader.compare import fmt
 
+EXERCISE = "ex07_small_gain"
 SOLUTION = ROOT / "instructor" / "mutext_grader" / "solutions" / "ex07_small_gain.py"
 SEED = 3
 MISTAKES = ("ex07_negative_feedback", "ex07_hz", "ex07_shortcuts", "ex07_stretch")
 
 
-def _load(path):
-    spec = importlib.util.spec_from_file_location(f"sub_{path.stem}", path)
-    mod = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(mod)
-    return mod
-
-
-def _payload(v, kind):
-    if kind == "ss":
-        S = v if isinstance(v, ct.StateSpace) else ct.ss(*v)
-        return {**{k: np.asarray(getattr(S, k), float).tolist() for k in "ABCD"}, "dt": 0}
-    v = np.asarray(v, float)
-    return {"data": v.ravel().tolist(), "shape": list(v.shape)}
-
-
-def _arg(a):
-    return ct.ss(*a["__ss__"]) if isinstance(a, dict) and "__ss__" in a else a
-
-
-_QUESTIONS = {}
-
-
 def drawn(seed=SEED):
-    if seed not in _QUESTIONS:
-        _QUESTIONS[seed] = {x.id: x for x in ex07.questions(np.random.default_rng(seed))}
-    return _QUESTIONS[seed]
-
-
-_SCORED = {}
+    return _drawn(EXERCISE, seed)
 
 
 def scored(path, seed=SEED):
-    """``{qid: (score, feedback text)}`` of a submission's functions run in this process."""
-    if (path, seed) not in _SCORED:
-        _SCORED[(path, seed)] = _scored(path, seed)
-    return _SCORED[(path, seed)]
-
-
-def _scored(path, seed):
-    mod = _load(path)
-    out = {}
-    for qid, question in drawn(seed).items():
-        outcomes = []
-        for c in question.calls:
-            try:
-                value = getattr(mod, question.function)(*[_arg(a) for a in c.args], **c.kwargs)
-                outcomes.append({"ok": True, "value": _payload(value, question.kind)})
-            except Exception as exc:   # noqa: BLE001 - reported as the confined child reports it
-                outcomes.append({"ok": False, "error": f"{type(exc).__name__}: {exc}"})
-        score, fb = question.check(outcomes)
-        out[qid] = (score, "\n".join(fb))
-    return out
+    """``{qid: (score, feedback text)}`` of a submission's functions run in this process
+    (tests/grading_harness.py)."""
+    return scored_here(EXERCISE, path, seed)
 
 
 def test_reference_m_closes_to_the_loop_with_perturbed_springs():

@@ -4,7 +4,6 @@ feedback of the reference, the stub, common mistakes and submissions that do not
 The default run scores (a) and (d) (no D-K) in this process on one draw and checks (c)'s answers that
 need no search; everything that runs D-K ((b), (c) of the reference and of the mistakes, the confined
 runs through ``grade``) is marked slow."""
-import importlib.util
 import re
 
 import control as ct
@@ -12,64 +11,26 @@ import numpy as np
 import pytest
 
 from grading_harness import ROOT, SUBS, full, q
+from grading_harness import drawn as _drawn
+from grading_harness import scored_here
 from mutext_grader import ex08_mbi as ex08
 from mutext_grader import grade
 from mutext_grader.compare import fmt
 
+EXERCISE = "ex08_mbi"
 SOLUTION = ROOT / "instructor" / "mutext_grader" / "solutions" / "ex08_mbi.py"
 SEED = 1
 CHEAP = ("a", "d")
 
 
-def _load(path):
-    spec = importlib.util.spec_from_file_location(f"sub_{path.stem}", path)
-    mod = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(mod)
-    return mod
-
-
-def _payload(v, kind):
-    if kind == "ss":
-        S = v if isinstance(v, ct.StateSpace) else ct.ss(*v)
-        return {**{k: np.asarray(getattr(S, k), float).tolist() for k in "ABCD"}, "dt": 0}
-    if kind == "float":
-        return float(v)
-    v = np.asarray(v, float)
-    return {"data": v.ravel().tolist(), "shape": list(v.shape)}
-
-
-def _arg(a):
-    return ct.ss(*a["__ss__"]) if isinstance(a, dict) and "__ss__" in a else a
-
-
-_QUESTIONS, _SCORED = {}, {}
-
-
 def drawn(seed=SEED):
-    if seed not in _QUESTIONS:
-        _QUESTIONS[seed] = {x.id: x for x in ex08.questions(np.random.default_rng(seed))}
-    return _QUESTIONS[seed]
+    return _drawn(EXERCISE, seed)
 
 
 def scored(path, qids=CHEAP, seed=SEED):
-    """``{qid: (score, feedback text)}`` of a submission's functions run in this process."""
-    key = (path, tuple(qids), seed)
-    if key not in _SCORED:
-        mod = _load(path)
-        out = {}
-        for qid in qids:
-            question = drawn(seed)[qid]
-            outcomes = []
-            for c in question.calls:
-                try:
-                    value = getattr(mod, question.function)(*[_arg(a) for a in c.args], **c.kwargs)
-                    outcomes.append({"ok": True, "value": _payload(value, question.kind)})
-                except Exception as exc:   # noqa: BLE001 - reported as the confined child reports it
-                    outcomes.append({"ok": False, "error": f"{type(exc).__name__}: {exc}"})
-            score, fb = question.check(outcomes)
-            out[qid] = (score, "\n".join(fb))
-        _SCORED[key] = out
-    return _SCORED[key]
+    """``{qid: (score, feedback text)}`` of a submission's functions run in this process
+    (tests/grading_harness.py)."""
+    return scored_here(EXERCISE, path, seed, qids)
 
 
 def _direct(rig, delta, Wz, w):
