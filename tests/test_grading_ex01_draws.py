@@ -2,16 +2,17 @@
 nothing for answers that do not solve the questions, no reference value in the feedback.
 
 Most checks run in this process on the questions of a seed (the submissions are the repository's
-own); one trivial submission goes through the confined child, the rest of those runs are slow.
+own); one trivial submission goes through the grader with its functions run in this process
+(tests/grading_harness.py); the confined runs are slow (ex01 is graded confined in
+tests/test_grading.py).
 """
 import importlib.util
-import threading
-from concurrent.futures import ThreadPoolExecutor
 
 import control as ct
 import numpy as np
 import pytest
 
+import grading_harness as harness
 from grading_harness import ROOT, SUBS, q
 from mutext_grader import grade
 from mutext_grader import ex01_two_mass_hinf as ex01
@@ -87,16 +88,9 @@ def _questions(seed):
 # graded in the background: one trivial submission by default, the reference on three seeds when slow
 # ----------------------------------------------------------------------------
 
-_pool = ThreadPoolExecutor(max_workers=2)
-_futures = {}
-_lock = threading.Lock()
-
-
 def graded(path, seed):
-    with _lock:
-        if (path, seed) not in _futures:
-            _futures[(path, seed)] = _pool.submit(grade, EXERCISE, path, seed=seed)
-    return _futures[(path, seed)].result()
+    """The report of ``path`` graded confined on the inputs of ``seed`` (tests/grading_harness.py: once)."""
+    return harness.graded(EXERCISE, path, seed)
 
 
 # ----------------------------------------------------------------------------
@@ -159,8 +153,15 @@ def test_trivial_submissions_earn_nothing_in_process(name):
         assert {qid: s for qid, (s, _) in res.items()} == {qid: 0 for qid in res}, (seed, res)
 
 
+@pytest.mark.slow
+def test_ex01_padded_confined_agrees_with_the_run_in_process():
+    """The default run grades ``ex01_padded.py`` with its functions run in this process; confined, the same."""
+    path = TRIVIAL / "ex01_padded.py"
+    harness.assert_same_scores_and_feedback(graded(path, SEEDS[0]), harness.graded_here(EXERCISE, path, SEEDS[0]))
+
+
 def test_padded_submission_graded_scores_zero_and_nothing_is_computed():
-    rep = graded(TRIVIAL / "ex01_padded.py", SEEDS[0])
+    rep = harness.graded_here(EXERCISE, TRIVIAL / "ex01_padded.py", SEEDS[0])
     assert rep.score == 0, rep.text()
     for qid in ("a", "b", "d"):
         assert "at most 12 are accepted" in q(rep, qid).output and "not evaluated" in q(rep, qid).output

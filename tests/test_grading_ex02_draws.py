@@ -2,14 +2,15 @@
 nothing for trivial, constant, random and library one-liner answers, no reference value in the feedback.
 
 The checks run in this process on the questions of a seed; one trivial submission goes through the
-confined child, the reference on three seeds only when slow (each run costs seconds).
+grader with its functions run in this process (tests/grading_harness.py); it and the reference on three
+seeds go through the confined child only when slow (each run costs seconds; ex02 is graded confined in
+tests/test_grading_ex02.py).
 """
-import threading
-from concurrent.futures import ThreadPoolExecutor
 
 import numpy as np
 import pytest
 
+import grading_harness as harness
 from grading_harness import ROOT, SUBS, q
 from mutext_grader import grade
 from mutext_grader import ex02_mu as ex02
@@ -21,16 +22,9 @@ REFERENCE = ROOT / "instructor" / "mutext_grader" / "solutions" / f"{EXERCISE}.p
 TRIVIAL = SUBS / "trivial"
 SEEDS = (21, 22, 23)
 
-_pool = ThreadPoolExecutor(max_workers=2)
-_futures = {}
-_lock = threading.Lock()
-
-
 def graded(path, seed):
-    with _lock:
-        if (path, seed) not in _futures:
-            _futures[(path, seed)] = _pool.submit(grade, EXERCISE, path, seed=seed)
-    return _futures[(path, seed)].result()
+    """The report of ``path`` graded confined on the inputs of ``seed`` (tests/grading_harness.py: once)."""
+    return harness.graded(EXERCISE, path, seed)
 
 
 def _questions(seed):
@@ -85,8 +79,15 @@ def test_trivial_submissions_earn_nothing_in_process(name):
         assert {qid: s for qid, (s, _) in res.items()} == {qid: 0 for qid in res}, (seed, res)
 
 
+@pytest.mark.slow
+def test_ex02_trivial_delta_confined_agrees_with_the_run_in_process():
+    """The default run grades ``ex02_trivial_delta.py`` with its functions run in this process; confined, the same."""
+    path = TRIVIAL / "ex02_trivial_delta.py"
+    harness.assert_same_scores_and_feedback(graded(path, SEEDS[0]), harness.graded_here(EXERCISE, path, SEEDS[0]))
+
+
 def test_trivial_delta_graded_scores_zero():
-    rep = graded(TRIVIAL / "ex02_trivial_delta.py", SEEDS[0])
+    rep = harness.graded_here(EXERCISE, TRIVIAL / "ex02_trivial_delta.py", SEEDS[0])
     assert rep.score == 0, rep.text()
     assert "diag(1/M_11, 0, ...)" in q(rep, "b").output
 
