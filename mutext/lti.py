@@ -762,6 +762,7 @@ class Stability:
         return self.stable
 
 
+@validate_params({"margin": Real(lo=0)})
 def stability(sys, margin: float = 0.0) -> Stability:
     r"""Scale-aware stability test of a continuous-time system, with the evidence.
 
@@ -803,8 +804,6 @@ def stability(sys, margin: float = 0.0) -> Stability:
     >>> s.stable, s.message[:26]
     (False, 'not decidably stable: pole')
     """
-    if not is_real_number(margin) or not np.isfinite(margin) or margin < 0:
-        raise ModelError(f"stability: margin must be a finite number >= 0 (rad/s), got {margin!r}")
     sys = as_ss(sys)
     if sys.nstates == 0:
         return Stability(True, np.zeros(0, complex), np.zeros(0), complex(np.nan), -np.inf,

@@ -329,9 +329,9 @@ def test_model_construction_errors():
     els = [ShaftElement(1, 0.1, 0.05, **STEEL), ShaftElement(2, 0.1, 0.05, **STEEL)]
     with pytest.raises(ModelError, match="two elements are named 'bearing1'"):
         Rotor(els + [BearingElement(1, 1e6), BearingElement(1, 2e6)])
-    with pytest.raises(ModelError, match=r"station/node must be an integer in 1\.\.3"):
+    with pytest.raises(ModelError, match="outside 1..3"):
         Rotor(els, outputs=[OutputPort("x9", 9)])
-    with pytest.raises(ModelError, match=r"station/node must be an integer in 1\.\.3"):
+    with pytest.raises(ModelError, match="outside 1..3"):
         Rotor(els + [BearingElement(5, 1e6)], n_stations=3)
     with pytest.raises(ModelError, match="direction 'v' does not exist in a 'plane'"):
         Rotor(els, planes=1, outputs=[OutputPort("y2", 2, "v")])

@@ -11,7 +11,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from .._validation import Integer, validate_params
+from .._validation import Integer, Options, validate_params
 from ..errors import IllPosedError, ModelError, SolverError
 from ._bounds import _both, _both_lower
 from ._certificate import MuUpper
@@ -226,7 +226,8 @@ def _fast_peaks(res, coords, response, S: BlockStructure, params: _DGParams, cer
         level = max(level, up.value)
 
 
-@validate_params({"npeaks": Integer(lo=0)})
+@validate_params({"method": Options(("auto", "lmi", "osborne", "fast")), "real": Options(("dg", "complex")),
+                  "npeaks": Integer(lo=0)})
 def mu_sweep(sys, structure: BlockStructure, omega=None, *, method: str = "auto", real: str = "dg",
              lower="peaks", refine: bool = True, npeaks: int = 3, rng=0, xtol: float = 1e-7,
              certify: bool = True) -> MuSweep:
@@ -317,10 +318,6 @@ def mu_sweep(sys, structure: BlockStructure, omega=None, *, method: str = "auto"
         lower = "none"
     if lower not in ("peaks", "all", "none"):
         raise ModelError(f"lower must be 'peaks', 'all' or 'none', got {lower!r}")
-    if method not in ("auto", "lmi", "osborne", "fast"):
-        raise ModelError(f"method must be 'auto', 'lmi', 'osborne' or 'fast', got {method!r}")
-    if real not in ("dg", "complex"):
-        raise ModelError(f"real must be 'dg' or 'complex', got {real!r}")
     omega = np.unique(omega)
     if refine and omega.size >= 2:
         extra = _resonance_points(_poles(sysss), omega[0], omega[-1])

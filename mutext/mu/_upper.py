@@ -3,7 +3,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from .._validation import NoneOr, Real, validate_params
+from .._validation import NoneOr, Options, Real, validate_params
 from ..errors import ModelError, SolverError
 from ._certificate import MuUpper, _diag_result, _gevp
 from ._fast import _DGParams, _fast_default, _fast_polish
@@ -101,7 +101,8 @@ def _upper_auto(M, S: BlockStructure, use_g: bool, lower, rtol: float, nrm: floa
     return up
 
 
-@validate_params({"lower": NoneOr(Real(lo=0))})
+@validate_params({"method": Options(("auto", "lmi", "osborne", "fast")), "real": Options(("dg", "complex")),
+                  "rtol": Real(0, 1, closed="neither"), "lower": NoneOr(Real(lo=0))})
 def mu_upper(M, structure: BlockStructure, *, method: str = "auto", real: str = "dg",
              rtol: float = 1e-6, lower: float | None = None) -> MuUpper:
     r"""Upper bound on :math:`\mu_{\boldsymbol\Delta}(M)` by D (or D-G) scaling.
@@ -173,12 +174,6 @@ def mu_upper(M, structure: BlockStructure, *, method: str = "auto", real: str = 
         if lower > cap * (1 + 1e-9):
             raise ModelError(f"lower={lower!r} cannot be a lower bound on mu: it exceeds sigma_max(M) = "
                              f"{cap:.6g}, an upper bound")
-    if method not in ("auto", "lmi", "osborne", "fast"):
-        raise ModelError(f"method must be 'auto', 'lmi', 'osborne' or 'fast', got {method!r}")
-    if real not in ("dg", "complex"):
-        raise ModelError(f"real must be 'dg' or 'complex', got {real!r}")
-    if not (np.isfinite(rtol) and 0 < rtol < 1):
-        raise ModelError(f"rtol must lie in (0, 1), got {rtol}")
     S = structure
     # the size of M for the range check and the rescaling (mu is homogeneous): the largest
     # entry, within a factor sqrt(size) of sigma_max and without an SVD

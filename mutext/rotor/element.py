@@ -165,7 +165,11 @@ class Layout:
         what : str, optional
             Name of the caller in the error message.
         """
-        return int(check_param(what, "station/node", node, Integer(1, self.n_nodes)))
+        within = Integer(1, self.n_nodes)
+        if not within.is_satisfied_by(node):
+            raise ModelError(f"{what}: station/node {node!r} is outside 1..{self.n_nodes} "
+                             f"(it must be {within.describe()})")
+        return int(node)
 
     def dof(self, node: int, label: str) -> int:
         """0-based global index of DOF ``label`` at 1-based ``node``.

@@ -197,7 +197,7 @@ def orbit(harmonics, speed: float, *, points: int = 361, label: str = "") -> Orb
         raise ModelError(f"orbit: harmonics must be a mapping order -> (X, Y), got {type(harmonics).__name__}")
     h = {}
     for k, xy in harmonics.items():
-        check_param("orbit", "a harmonic order", k, Integer(lo=0))
+        check_param("orbit", "each of the harmonic orders", k, Integer(lo=0))
         try:
             X, Y = (complex(v) for v in xy)
         except (TypeError, ValueError):
