@@ -10,7 +10,11 @@ confined child replaced by a run of the submission's functions in this process (
 only for the repository's own, well-behaved submissions).  The questions, the inputs of the seed, the
 encoding and validation of the returned values, the checks, the collapsed feedback and the report are the
 grader's own; what it leaves out (the child, its time limits, the integrity guard) is checked on the
-confined runs of the reference, the stub and the cheating, crashing and hostile submissions.
+confined runs of the reference and the cheating, crashing and hostile submissions, and by the ``-m slow``
+tests that grade the others confined and compare (:func:`assert_same_scores_and_feedback`).
+``check_here`` is ``mutext check`` (:func:`mutext.grading.check.check`) likewise; ``scored_here`` feeds
+chosen questions' checks directly (no report); ``drawn`` memoises an exercise's questions of a seed;
+``grade_without_warm_up`` grades confined without the warm-up of the reference computations.
 
 :class:`Submissions` names an exercise's files (the reference solution, the stub and
 ``tests/grading_submissions/<prefix>_*.py``) on the seed of a test module: ``graded(name)`` confined,
@@ -225,9 +229,9 @@ class Submissions:
     """An exercise's reference solution (``"reference"``), stub (``"stub"``) and
     ``tests/grading_submissions/<prefix>_*.py``, and ``extra`` files, graded on the inputs of ``seed``.
 
-    ``graded(name)`` (confined) starts the ``confined`` names in the background the first time, the
-    reference first; ``graded.here(name)`` runs the functions in this process; ``seed`` overrides the
-    module's seed for one run."""
+    ``graded(name)`` (confined) starts the ``confined`` names in the background the first time, in that
+    order; ``graded.here(name)`` runs the functions in this process; ``seed`` overrides the module's seed
+    for one run; ``time_limits`` gives a name its own time limit."""
 
     def __init__(self, exercise, seed, *, extra=None, confined=("reference",), time_limit=60.0, time_limits=None):
         self.exercise = get_exercise(exercise).name

@@ -138,6 +138,7 @@ def test_textbook_example_values():
     assert abs(np.linalg.det(np.eye(2) - M @ D)) < 1e-9 and abs(np.linalg.norm(D, 2) - 1 / 3) < 1e-6
 
 
+@pytest.mark.slow     # the default run: test_reference_solution_scores_full_marks, the same on the same seed, confined
 def test_full_marks_in_process():
     for qid, fn, wrap in (("a1", sol.mu_full, _float), ("a2", sol.mu_scalar_blocks_upper, _float),
                           ("b", sol.destabilizing_delta, _arr), ("c", sol.uncertain_spring_lft, lambda v: _ss(*v)),

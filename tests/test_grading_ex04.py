@@ -1,10 +1,11 @@
 """Autograder of exercise ex04_beam_element: scores, feedback, integrity (mutext.rotor blocked).
 
-On the inputs of one seed the reference solution, the submission that imports and reads mutext.rotor
-and one trivial submission with oversized arrays are graded confined (tests/grading_harness.py: once,
-in the background); the stub and the submissions ``tests/grading_submissions/ex04_*.py`` go through
+On the inputs of one seed the reference solution and the submission that imports and reads mutext.rotor
+are graded confined (tests/grading_harness.py: once, in the background); the stub, the submissions
+``tests/grading_submissions/ex04_*.py`` and one trivial submission with oversized arrays go through
 the same grader with their functions run in this process (all of them confined, and the reference on
-two more seeds, with ``-m slow``); the trivial submissions
+two more seeds, with ``-m slow``; the size caps on what the child returns are checked confined in
+tests/test_grading_resources.py); the trivial submissions
 ``tests/grading_submissions/trivial/ex04_*.py`` are scored in-process on several seeds (graded one by
 one with ``-m slow``); the feedback of each diagnosis is also checked in-process on constructed
 answers, and that it never contains a reference value.
@@ -27,7 +28,7 @@ MORE_SEEDS = (7, 123456789)      # the reference solution scores full marks on t
 TRIVIAL = {p.stem: p for p in (SUBS / "trivial").glob("ex04_*.py")}
 
 graded = Submissions(EXERCISE, SEED, extra={"ex04_oversized": TRIVIAL["ex04_oversized"]},
-                     confined=("reference", "ex04_cheat_rotor", "ex04_oversized"))
+                     confined=("reference", "ex04_cheat_rotor"))
 SUBMISSIONS = graded.paths
 CASES = ex04.draw(np.random.default_rng(SEED))       # the inputs the submissions above were graded on
 #: graded in this process by default, confined with -m slow
@@ -72,7 +73,7 @@ def test_confined_run_agrees_with_the_run_in_process(name):
 
 
 def test_oversized_arrays_score_zero_unanalysed():
-    rep = graded("ex04_oversized")
+    rep = graded.here("ex04_oversized")
     assert rep.score == 0 and all(x.status == "ok" for x in rep.questions)
     assert "must return the pair (K, M) of 4x4 arrays" in q(rep, "a").output
     for n, *_ in CASES["b"]:
