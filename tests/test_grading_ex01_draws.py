@@ -6,15 +6,13 @@ own); one trivial submission goes through the grader with its functions run in t
 (tests/grading_harness.py); the confined runs are slow (ex01 is graded confined in
 tests/test_grading.py).
 """
-import importlib.util
 
 import control as ct
 import numpy as np
 import pytest
 
 import grading_harness as harness
-from grading_harness import ROOT, SUBS, q
-from mutext_grader import grade
+from grading_harness import ROOT, SUBS, load, q
 from mutext_grader import ex01_two_mass_hinf as ex01
 from mutext_grader.solutions import ex01_two_mass_hinf as sol
 
@@ -27,13 +25,6 @@ SEEDS = (11, 12, 13)
 # ----------------------------------------------------------------------------
 # running a submission's functions in this process (also used by the ex02 tests)
 # ----------------------------------------------------------------------------
-
-def load(path):
-    spec = importlib.util.spec_from_file_location(f"submission_{path.stem}", path)
-    mod = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(mod)
-    return mod
-
 
 def encode(kind, value):
     """The plain value the child would send back for ``kind``."""

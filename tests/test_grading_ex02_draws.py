@@ -11,11 +11,10 @@ import numpy as np
 import pytest
 
 import grading_harness as harness
-from grading_harness import ROOT, SUBS, q
-from mutext_grader import grade
+from grading_harness import ROOT, SUBS, load, q
 from mutext_grader import ex02_mu as ex02
 from mutext_grader.solutions import ex02_mu as sol
-from test_grading_ex01_draws import leaks, load, scores
+from test_grading_ex01_draws import leaks, scores
 
 EXERCISE = "ex02_mu"
 REFERENCE = ROOT / "instructor" / "mutext_grader" / "solutions" / f"{EXERCISE}.py"
