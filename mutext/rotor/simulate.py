@@ -157,6 +157,35 @@ def simulate_breathing_jeffcott(mass, k0, dk_xi, speed, *, dk_eta=0.0, damping_r
     -------
     JeffcottResult
     """
+    m, k0, W, dk_xi, dk_eta, zeta = _checked_jeffcott(mass, k0, dk_xi, speed, dk_eta, damping_ratio, model)
+    w0 = np.sqrt(k0 / m)
+    cdamp = 2.0 * zeta * np.sqrt(k0 * m)
+    period = 2.0 * np.pi / W
+    if n_settle is None:
+        n_settle = int(np.ceil(12.0 / (zeta * w0) / period))
+    scale = max(m * abs(gravity) / k0, m * abs(eccentricity) * W**2 / k0, 1e-12)
+    atol = 1e-9 * scale if atol is None else atol
+    rhs = _jeffcott_rhs(m, k0, dk_xi, dk_eta, cdamp, W, eccentricity, unbalance_angle, gravity, crack_angle0,
+                        model)
+    z0 = [0.0, -m * gravity / k0, 0.0, 0.0]
+    t_end_settle = n_settle * period
+    t_rec = t_end_settle + period * np.arange(n_record * samples_per_rev) / samples_per_rev
+    # the Gasch law switches twice per turn: cap the step so no switch is stepped over blindly
+    max_step = period / 16.0 if model == "gasch" else np.inf
+    sol = solve_ivp(rhs, (0.0, t_rec[-1]), z0, method="DOP853", t_eval=t_rec, rtol=rtol,
+                    atol=atol, max_step=max_step)
+    if not sol.success:
+        raise SolverError(f"simulate_breathing_jeffcott: integration failed: {sol.message}")
+    return JeffcottResult(t=sol.t, x=sol.y[0], y=sol.y[1], speed=W, natural_frequency=w0,
+                          model=model,
+                          params=dict(mass=m, k0=k0, dk_xi=dk_xi, dk_eta=dk_eta,
+                                      damping_ratio=zeta, eccentricity=eccentricity,
+                                      unbalance_angle=unbalance_angle, gravity=gravity,
+                                      crack_angle0=crack_angle0, n_settle=n_settle))
+
+
+def _checked_jeffcott(mass, k0, dk_xi, speed, dk_eta, damping_ratio, model):
+    """``(m, k0, speed, dk_xi, dk_eta, damping_ratio)`` of :func:`simulate_breathing_jeffcott` as floats, checked."""
     m = float(_positive(mass, "mass", "kg"))
     k0 = float(_positive(k0, "k0", "N/m"))
     W = float(_positive(speed, "speed", "rad/s"))
@@ -169,13 +198,11 @@ def simulate_breathing_jeffcott(mass, k0, dk_xi, speed, *, dk_eta=0.0, damping_r
     zeta = float(damping_ratio)
     if zeta <= 0:
         raise ModelError(f"damping_ratio must be > 0 for a steady state to exist, got {zeta}")
-    w0 = np.sqrt(k0 / m)
-    cdamp = 2.0 * zeta * np.sqrt(k0 * m)
-    period = 2.0 * np.pi / W
-    if n_settle is None:
-        n_settle = int(np.ceil(12.0 / (zeta * w0) / period))
-    scale = max(m * abs(gravity) / k0, m * abs(eccentricity) * W**2 / k0, 1e-12)
-    atol = 1e-9 * scale if atol is None else atol
+    return m, k0, W, dk_xi, dk_eta, zeta
+
+
+def _jeffcott_rhs(m, k0, dk_xi, dk_eta, cdamp, W, eccentricity, unbalance_angle, gravity, crack_angle0, model):
+    """The right-hand side ``f(t, [x, y, vx, vy])`` of the Jeffcott rotor's equations of motion."""
     s = 0.5 * (dk_xi + dk_eta)
     d = 0.5 * (dk_xi - dk_eta)
     ue = m * eccentricity * W**2
@@ -194,18 +221,4 @@ def simulate_breathing_jeffcott(mass, k0, dk_xi, speed, *, dk_eta=0.0, damping_r
         ay = (fy - cdamp * vy - kxy * x - kyy * y) / m
         return [vx, vy, ax, ay]
 
-    z0 = [0.0, -m * gravity / k0, 0.0, 0.0]
-    t_end_settle = n_settle * period
-    t_rec = t_end_settle + period * np.arange(n_record * samples_per_rev) / samples_per_rev
-    # the Gasch law switches twice per turn: cap the step so no switch is stepped over blindly
-    max_step = period / 16.0 if model == "gasch" else np.inf
-    sol = solve_ivp(rhs, (0.0, t_rec[-1]), z0, method="DOP853", t_eval=t_rec, rtol=rtol,
-                    atol=atol, max_step=max_step)
-    if not sol.success:
-        raise SolverError(f"simulate_breathing_jeffcott: integration failed: {sol.message}")
-    return JeffcottResult(t=sol.t, x=sol.y[0], y=sol.y[1], speed=W, natural_frequency=w0,
-                          model=model,
-                          params=dict(mass=m, k0=k0, dk_xi=dk_xi, dk_eta=dk_eta,
-                                      damping_ratio=zeta, eccentricity=eccentricity,
-                                      unbalance_angle=unbalance_angle, gravity=gravity,
-                                      crack_angle0=crack_angle0, n_settle=n_settle))
+    return rhs

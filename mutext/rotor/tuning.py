@@ -289,17 +289,9 @@ def tune(model, frfs, parameters, bounds: Mapping | None = None, *, start: Mappi
     SolverError
         If IPOPT does not converge (the message gives IPOPT's return status).
     """
-    from .analysis import blas_single_thread
     t_build = time.perf_counter()
     model = _as_model(model)
-    from .lumped_elements import impedances
-    if impedances(model):
-        # the fitted responses are built from M, C, K; K(s) of the element would be left out silently
-        raise ModelError(f"tune: {model.name} holds the impedance element '{impedances(model)[0].name}' "
-                         "(a rational K(s), not part of M, C, K); tune the model without it")
-    frfs = [frfs] if isinstance(frfs, FRF) else list(frfs)
-    if not frfs:
-        raise ModelError("tune: no FRFs given")
+    frfs = _checked_frfs(model, frfs)
     entries = _entries(model, parameters)
     v0 = _start_vector(model, values, start)
     bounds = dict(bounds or {})
@@ -318,6 +310,32 @@ def tune(model, frfs, parameters, bounds: Mapping | None = None, *, start: Mappi
     build_seconds = time.perf_counter() - t_build
 
     t0 = time.perf_counter()
+    theta, status, iters, r_start, fit = _solve(objective, problem, unknowns)
+    seconds = time.perf_counter() - t0
+    if progress is not None:
+        progress(f"tune: {status}, {iters} iterations, {seconds:.1f} s", 1.0)
+    return _tune_result(model, unknowns, objective, chans, theta, r_start, fit,
+                        n_pts=n_pts, status=status, iterations=iters, seconds=seconds,
+                        build_seconds=build_seconds, history=history)
+
+
+def _checked_frfs(model, frfs) -> list:
+    """The measured FRFs as a list (one FRF or a sequence), for a model :func:`tune` can fit."""
+    from .lumped_elements import impedances
+    if impedances(model):
+        # the fitted responses are built from M, C, K; K(s) of the element would be left out silently
+        raise ModelError(f"tune: {model.name} holds the impedance element '{impedances(model)[0].name}' "
+                         "(a rational K(s), not part of M, C, K); tune the model without it")
+    frfs = [frfs] if isinstance(frfs, FRF) else list(frfs)
+    if not frfs:
+        raise ModelError("tune: no FRFs given")
+    return frfs
+
+
+def _solve(objective, problem, unknowns):
+    """IPOPT from the start values: ``(theta, status, iterations, start residuals, (rr, r, JJ))``,
+    the last the objective's residuals and Gauss-Newton terms at the optimum."""
+    from .analysis import blas_single_thread
     scale = unknowns.scale
     with blas_single_thread():
         _, r_start = objective.evaluate(unknowns.x0 / scale, False)
@@ -326,11 +344,15 @@ def tune(model, frfs, parameters, bounds: Mapping | None = None, *, start: Mappi
             raise SolverError(f"IPOPT did not converge: return status {status} after {iters} iterations "
                               f"(parameters {unknowns.names}; last values "
                               f"{dict(zip(unknowns.names, (scale * theta).tolist()))})")
-        rr, r, JJ = objective.evaluate(theta, True)
-    seconds = time.perf_counter() - t0
-    if progress is not None:
-        progress(f"tune: {status}, {iters} iterations, {seconds:.1f} s", 1.0)
+        fit = objective.evaluate(theta, True)
+    return theta, status, iters, r_start, fit
 
+
+def _tune_result(model, unknowns, objective, chans, theta, r_start, fit, *, n_pts, status, iterations,
+                 seconds, build_seconds, history) -> TuneResult:
+    """The :class:`TuneResult` of the optimum ``theta`` (scaled unknowns)."""
+    rr, r, JJ = fit
+    scale = unknowns.scale
     xopt = scale * theta
     cov, corr, sd, sigma2 = _covariance(rr, JJ, scale)
     vfit = objective.full_vector(xopt)
@@ -351,7 +373,7 @@ def tune(model, frfs, parameters, bounds: Mapping | None = None, *, start: Mappi
         member_values={model.parameter_names[i]: float(vfit[i]) for i in unknowns.members},
         parameter_vector=vfit,
         residual_rms_db=rms_db, residual_rms_deg=rms_deg, start_rms_db=start_db, start_rms_deg=start_deg,
-        channel_rms=ch_rms, sigma=math.sqrt(sigma2), n_points=n_pts, status=status, iterations=iters,
+        channel_rms=ch_rms, sigma=math.sqrt(sigma2), n_points=n_pts, status=status, iterations=iterations,
         seconds=seconds, build_seconds=build_seconds, history=history, n_solves=objective.evaluator.n_solves)
 
 
