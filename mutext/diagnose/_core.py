@@ -5,7 +5,7 @@ import logging
 import math
 import os
 import time
-from dataclasses import replace
+from dataclasses import dataclass, replace
 from typing import Callable
 
 import numpy as np
@@ -25,9 +25,9 @@ from .faults import structure as _structure
 from ._result import ChannelComparison, Diagnosis, Finding
 from ._channels import _resolve, _src
 from ._fit_quality import fit_quality, noise_reference
-from ._screen import (_Data, _Evaluator, _Receptance, _fit_size, _fit_vector, _jacobian_std, _rss,
-                      _separating_station)
-from ._select import MAX_EFFECTS, Compound, _rss_of, at_bound, fit_one_given, joint_fit
+from ._screen import _Data, _Evaluator, _Receptance, _fit_size, _fit_vector, _jacobian_std, _rss
+from ._decision import _decide, _finding, _in_model_file, _judge, _select_more, _status
+from ._select import Compound
 
 log = logging.getLogger("mutext.diagnose")
 
@@ -124,7 +124,32 @@ def diagnose(model, frfs, validate=None, *, alpha: float = 0.01, refit: int = 3,
         return _diagnose(model, frfs, validate, alpha, refit, noise, out_dir, progress, only, mbi)
 
 
+@dataclass
+class _Reading:
+    """What the first step of :func:`diagnose` reads and every later step uses.
+
+    ``path``, ``eng``, ``model_text``: the model file, its model and its text; ``chans``, ``vchans``: the
+    fitted and the validation channels; ``speed``: their running speed (rad/s); ``ref``: the noise
+    reference, ``s2`` the noise variance of one real number; ``rec``: the engineering model's receptance on
+    one grid for all; ``fit``, ``held``, ``all_fit``: the fitted, held-out and all fitted data sets;
+    ``held_desc``: what the held-out data are."""
+    path: str
+    eng: object
+    model_text: str
+    chans: list
+    vchans: list
+    speed: float
+    ref: object
+    s2: float
+    rec: object
+    fit: object
+    held: object
+    all_fit: object
+    held_desc: str
+
+
 def _diagnose(model, frfs, validate, alpha, refit, noise, out_dir, progress, only, mbi) -> Diagnosis:
+    """:func:`diagnose`, step by step (its arguments in the same order)."""
     t0 = time.perf_counter()
 
     def tell(stage, frac):
@@ -132,86 +157,146 @@ def _diagnose(model, frfs, validate, alpha, refit, noise, out_dir, progress, onl
         if progress is not None:
             progress(stage, frac)
 
+    d, notes = _read(model, frfs, validate, alpha, noise, tell)
+    # 1. what the simulation gets wrong
+    before, rows, summary, unmatched = _what_is_wrong(d)
+    # 2. the hypotheses, screened, the best refitted on the extended model, the verdict
+    hyps, N, rss0, threshold, findings = _screened(d, alpha, refit, only, notes, tell)
+    none, verdict, ambiguous, sensor = _verdict(d, findings, N, rss0, threshold, notes)
+    # 3. goodness of fit; further effects while the residual stays above the noise
+    effects, quality, first, verdict = _selection(d, verdict, none, hyps, N, threshold, alpha, notes, tell)
+    # 4. the extended model and its gain on held-out data
+    text, quality, err_before, err_after, gain, comps, held_quality, status = _held_out(
+        d, verdict, none, effects, quality, first, before, alpha, notes, tell)
+    localized = _localized(d, status, notes, tell)
+    result = Diagnosis(d.eng.name, d.path, d.ref.sigma, findings, verdict, ambiguous, sensor, err_before, err_after,
+                       gain, d.held_desc, comps, rows, summary, threshold, alpha, len(hyps), text,
+                       time.perf_counter() - t0, notes, N, status=status, effects=effects, fit_quality=quality,
+                       noise_reference=d.ref, unmatched=unmatched, localized=localized,
+                       held_quality=held_quality)
+    # 5. data taken at speed: sidebands, a crack turning with the shaft
+    _at_speed(result, d, effects, text, findings, verdict, err_after, rss0, tell, t0)
+    # 6. model-based identification at the finding, or where the misfit lives
+    _mbi_fallback(result, d, mbi, verdict, none, localized, err_before, alpha, tell, t0)
+    if out_dir is not None:
+        write_model(result, out_dir)
+    tell("done", 1.0)
+    return result
+
+
+def _read(model, frfs, validate, alpha, noise, tell):
+    """The model file and the data, checked; the noise level; the engineering model's receptance and the data
+    sets: ``(reading, notes on the inputs)``."""
     # a rotor's model is built (symbolic finite elements) while the files are read: seconds to tens of seconds
     tell("reading the model file and the data (a rotor's finite elements are built here)", 0.0)
     path, eng, model_text, chans, vchans, speed, input_notes = _inputs(model, frfs, validate, alpha)
     tell("noise level of the data (model-free rational fits)", 0.01)
     ref = noise_reference(chans, _noise(noise))
-    noise = ref.sigma
-    s2 = noise ** 2 / 2.0
+    s2 = ref.sigma ** 2 / 2.0
     tell("engineering model's receptance", 0.02)
     allf = np.unique(np.concatenate([c.frf.freq_hz for c in chans + vchans]))    # one grid for all
     rec = _Receptance(eng, None, speed, 2 * np.pi * allf)
     fit, held, all_fit, held_desc = _data_sets(rec, allf, chans, vchans)
+    reading = _Reading(path, eng, model_text, chans, vchans, speed, ref, s2, rec, fit, held, all_fit, held_desc)
+    return reading, input_notes
 
-    # 1. what the simulation gets wrong
-    before = all_fit.H0
+
+def _what_is_wrong(d):
+    """What the simulation gets wrong: ``(the model's responses on the fitted channels, the resonance table,
+    its summary, the unmatched resonances)``."""
+    before = d.all_fit.H0
     unmatched: dict = {}
-    rows = _resonance_table(chans, before, eng, speed, noise, unmatched)
+    rows = _resonance_table(d.chans, before, d.eng, d.speed, d.ref.sigma, unmatched)
     unmatched["measured"] = _group_unmatched(unmatched.get("measured", []))
-    summary = _summary(rows, chans, before)
+    summary = _summary(rows, d.chans, before)
+    return before, rows, summary, unmatched
 
-    # 2. the hypotheses, screened, the best refitted on the extended model, the verdict
-    hyps = hypotheses(eng) + _channel.candidates(eng, chans) + _structure.candidates(eng)
+
+def _screened(d, alpha, refit, only, notes, tell):
+    """The hypotheses screened and the best few refitted on the extended model (notes on failed refits go to
+    ``notes``): ``(hypotheses, number of real data N, rss of the engineering model, threshold, findings)``."""
+    hyps = hypotheses(d.eng) + _channel.candidates(d.eng, d.chans) + _structure.candidates(d.eng)
     if only is not None:
         hyps = [h for h in hyps if only(h)]
         if not hyps:
             raise ModelError("diagnose: no hypothesis passes the 'only' filter")
-    N = 2 * fit.n_points
-    rss0 = _rss(fit.H0, fit.meas)
+    N = 2 * d.fit.n_points
+    rss0 = _rss(d.fit.H0, d.fit.meas)
     threshold = float(sst.chi2.isf(alpha / len(hyps), 1))
-    findings = _screen_all(hyps, rec, fit, s2, N, rss0, threshold, tell)
-    notes = input_notes + _refit_best(findings, refit, model_text, path, eng, fit, s2, N, rss0, threshold, tell)
+    findings = _screen_all(hyps, d.rec, d.fit, d.s2, N, rss0, threshold, tell)
+    notes += _refit_best(findings, refit, d.model_text, d.path, d.eng, d.fit, d.s2, N, rss0, threshold, tell)
+    return hyps, N, rss0, threshold, findings
+
+
+def _verdict(d, findings, N, rss0, threshold, notes):
+    """Each finding judged, "no effect" ranked among them, the verdict decided: ``(the "none" finding, the
+    verdict, those it cannot be told from, the sensor station that would separate them)``."""
     for f in findings:
         _judge(f, N, threshold)
     for f in findings[:5]:
         if f.at_bound:
             notes.append(f"{f.description} fits best at the bound of its range ({f.size_text(std=False)}): "
                          "not accepted (the data ask for more than the hypothesis allows)")
-    none = Finding("none", None, None, 0.0, "", 0.0, rss0 / s2, 0.0, "no effect beyond the noise")
+    none = Finding("none", None, None, 0.0, "", 0.0, rss0 / d.s2, 0.0, "no effect beyond the noise")
     findings.sort(key=lambda f: f.score)
     findings.insert(next((i for i, f in enumerate(findings) if f.score > none.score), len(findings)), none)
-    verdict, ambiguous, sensor = _decide(findings, none, threshold, N, rec, fit, eng, notes, held, s2)
+    verdict, ambiguous, sensor = _decide(findings, none, threshold, N, d.rec, d.fit, d.eng, notes, d.held, d.s2)
+    return none, verdict, ambiguous, sensor
 
-    # 3. goodness of fit; further effects while the residual stays above the noise
+
+def _selection(d, verdict, none, hyps, N, threshold, alpha, notes, tell):
+    """Further effects while the residual stays above the noise: ``(effects, fit quality of the last model,
+    fit quality of the first effect's model file or None, verdict)``."""
     effects = [] if verdict is none else [verdict]
     first = None
     if _in_model_file(verdict):
         # the model file with the finding is what the user receives (with modal damping its damping follows
         # the change, which the screen holds fixed): judged on its own responses
-        first = _quality_of_file(verdict, model_text, eng, path, rec, chans, all_fit, held, s2, ref, alpha)
-    effects, quality = _select_more(effects, hyps, rec, fit, held, s2, N, threshold, alpha, ref, notes, tell,
-                                    first)
+        first = _quality_of_file(verdict, d.model_text, d.eng, d.path, d.rec, d.chans, d.all_fit, d.held, d.s2,
+                                 d.ref, alpha)
+    effects, quality = _select_more(effects, hyps, d.rec, d.fit, d.held, d.s2, N, threshold, alpha, d.ref, notes,
+                                    tell, first)
     if len(effects) > 1:
         verdict = effects[0]
+    return effects, quality, first, verdict
 
-    # 4. the extended model and its gain on held-out data
+
+def _held_out(d, verdict, none, effects, quality, first, before, alpha, notes, tell):
+    """The extended model and its gain on held-out data: ``(extended model text, fit quality, errors before
+    and after, gain, channel comparisons, held-out fit quality, status)``."""
     tell("held-out gain", 0.95)
     text = None
     if effects:
-        text = model_text
+        text = d.model_text
         for e in effects:
-            text = extended_model_text(text, e, eng)
+            text = extended_model_text(text, e, d.eng)
     if len(effects) > 1:
         comp = [e.hypothesis for e in effects], [e.theta for e in effects]
-        after_all = Compound(rec, all_fit, comp[0]).responses(comp[1])
-        after_held = Compound(rec, held, comp[0]).responses(comp[1])
+        after_all = Compound(d.rec, d.all_fit, comp[0]).responses(comp[1])
+        after_held = Compound(d.rec, d.held, comp[0]).responses(comp[1])
     else:
-        after_all, after_held = _after(verdict, text, path, rec, chans, all_fit, held)
+        after_all, after_held = _after(verdict, text, d.path, d.rec, d.chans, d.all_fit, d.held)
         if _in_model_file(verdict):
             quality = first
+    held = d.held
     err_before = _errors(held.H0, held.meas)
     err_after = _errors(after_held, held.meas)
     gain = err_before["rel"] / err_after["rel"] if err_after["rel"] > 0 else math.inf
     comps = [ChannelComparison(c.label, _src(c.frf, k + 1), c.frf.freq_hz, c.frf.response, before[k],
-                               None if after_all is None else after_all[k], "fit") for k, c in enumerate(chans)]
+                               None if after_all is None else after_all[k], "fit") for k, c in enumerate(d.chans)]
     comps += [ChannelComparison(c.label, _src(c.frf, k + 1), c.frf.freq_hz, c.frf.response, held.H0[k],
                                 None if verdict is none else after_held[k], "validate")
-              for k, c in enumerate(vchans)]
+              for k, c in enumerate(d.vchans)]
     with np.errstate(all="ignore"):
         held_quality = fit_quality([np.log(h / m) for h, m in zip(after_held, held.meas)], held.freq_hz,
-                                   [c.label for c in held.chans], s2, 0, ref, alpha)
+                                   [c.label for c in held.chans], d.s2, 0, d.ref, alpha)
     status = _status(effects, quality, gain, held_quality)
+    _held_out_notes(effects, quality, held_quality, gain, status, notes)
+    return text, quality, err_before, err_after, gain, comps, held_quality, status
+
+
+def _held_out_notes(effects, quality, held_quality, gain, status, notes) -> None:
+    """Notes on a misfit left on the fitted or the held-out data (the effects' stds inflated by it)."""
     if quality.at_noise and not held_quality.at_noise:
         notes.append(f"the fitted data are explained, the held-out data are not: misfit {held_quality.misfit:.3g} "
                      f"times the noise (at most {held_quality.limit:.3g}), {held_quality.where()}")
@@ -224,71 +309,81 @@ def _diagnose(model, frfs, validate, alpha, refit, noise, out_dir, progress, onl
     if effects and status == "not explained" and not gain > 1:
         notes.append(f"the extended model fits the held-out data worse than the engineering model "
                      f"(gain {gain:.3g}x): it is not a fix")
+
+
+def _localized(d, status, notes, tell):
+    """Where the misfit lives (an impedance at each station) when the data are not explained, or None."""
     localized = None
     if status != "explained":
         tell("where the misfit lives (an impedance at each station)", 0.955)
         from ._localize import describe, localize
-        localized = localize(rec, fit, held, eng, s2)
+        localized = localize(d.rec, d.fit, d.held, d.eng, d.s2)
         if localized is not None:
             notes.append(describe(localized))
-    result = Diagnosis(eng.name, path, noise, findings, verdict, ambiguous, sensor, err_before, err_after, gain,
-                       held_desc, comps, rows, summary, threshold, alpha, len(hyps), text,
-                       time.perf_counter() - t0, notes, N, status=status, effects=effects, fit_quality=quality,
-                       noise_reference=ref, unmatched=unmatched, localized=localized,
-                       held_quality=held_quality)
-    if speed > 0 and hasattr(eng, "n_stations"):
+    return localized
+
+
+def _at_speed(result, d, effects, text, findings, verdict, err_after, rss0, tell, t0) -> None:
+    """Data taken at speed on a rotor: the sideband evidence, a crack turning with the shaft when the
+    sidebands call for one, and whether the time-periodic claim is made (all into ``result``)."""
+    if d.speed > 0 and hasattr(d.eng, "n_stations"):
         # where to look: the modes of the best time-invariant model (a mode the engineering model misplaces
         # is not a sideband)
-        best_ti = eng
+        best_ti = d.eng
         if text is not None and any(e.hypothesis.gain is None for e in effects):
             try:
-                best_ti = loads_model(text, source=f"{path} (extended)",
-                                      base_dir=os.path.dirname(os.path.abspath(path)))
+                best_ti = loads_model(text, source=f"{d.path} (extended)",
+                                      base_dir=os.path.dirname(os.path.abspath(d.path)))
             except ModelError:
                 pass
-        result.sidebands = _sidebands(best_ti, speed, chans)
-        if result.sidebands and result.sidebands["verdict"] != "none" and model_text is not None:
+        result.sidebands = _sidebands(best_ti, d.speed, d.chans)
+        if result.sidebands and result.sidebands["verdict"] != "none" and d.model_text is not None:
             tell("a crack that turns with the shaft, at the best crack station (time-periodic fit)", 0.96)
-            result.breathing = _breathing(findings, result.sidebands, model_text, path, speed, chans, fit,
-                                          held, s2, rss0, verdict, err_after, result.notes)
+            result.breathing = _breathing(findings, result.sidebands, d.model_text, d.path, d.speed, d.chans,
+                                          d.fit, d.held, d.s2, rss0, verdict, err_after, result.notes)
             result.seconds = time.perf_counter() - t0
         _sideband_claim(result)
+
+
+def _mbi_fallback(result, d, mbi, verdict, none, localized, err_before, alpha, tell, t0) -> None:
+    """With ``mbi``: model-based identification at the verdict or, not explained on a lumped chain, where
+    the misfit lives, the controller then written as an element of the model (all into ``result``)."""
     at = verdict
-    if mbi and localized is not None and eng.layout.kind == "lumped":
+    if mbi and localized is not None and d.eng.layout.kind == "lumped":
         # not explained: the thesis's controller goes where the misfit lives, read against that element
         h = Hypothesis("mass", localized["station"], None, f"element at station {localized['station']}", "kg",
                        True, 0.0, math.inf, 1.0, [localized["dof"]])
         at = Finding("mass", localized["station"], None, localized["msd"]["m"], "kg", math.inf, 0.0, 0.0,
                      h.description, hypothesis=h)
-    if mbi and at is not none:
-        tell("model-based identification at the finding (D-K iteration)", 0.97)
-        # the controller is tuned on the first channel's fitted lines only: the held-out lines, on which the
-        # element it becomes is judged, stay unseen
-        k0 = 0 if at is verdict else _channel_at(fit.chans, at.station)
-        c0 = fit.chans[k0]
-        seen = replace(c0.frf, freq_hz=fit.freq_hz[k0], response=fit.meas[k0], metadata=dict(c0.frf.metadata))
-        try:
-            result.mbi, res, E = _identify_at(model_text, path, at, seen, c0.in_name, c0.out_name,
-                                              progress=lambda stage, frac: tell(
-                                                  f"model-based identification: {stage}", 0.97 + 0.02 * frac))
-        except ModelError as exc:
-            result.mbi = {"location": None, "reading": f"not run: {exc}", "agrees": None}
-        else:
-            if at is not verdict:
-                # nothing the hypotheses name explains the data: K itself becomes the element of the model
-                tell("the controller as an element of the model, judged on the held-out data", 0.99)
-                try:
-                    result.mbi.update(mbi_element(result.mbi, res, E, model_text, eng, localized["station"],
-                                                  localized["dof"], rec, held, s2, ref, alpha, seen, c0.in_name,
-                                                  c0.out_name, err_before))
-                except ModelError as exc:
-                    result.mbi["element"] = None
-                    result.notes.append(f"the controller was not written as an element: {exc}")
-        result.seconds = time.perf_counter() - t0
-    if out_dir is not None:
-        write_model(result, out_dir)
-    tell("done", 1.0)
-    return result
+    if not (mbi and at is not none):
+        return
+    tell("model-based identification at the finding (D-K iteration)", 0.97)
+    # the controller is tuned on the first channel's fitted lines only: the held-out lines, on which the
+    # element it becomes is judged, stay unseen
+    fit = d.fit
+    k0 = 0 if at is verdict else _channel_at(fit.chans, at.station)
+    c0 = fit.chans[k0]
+    seen = replace(c0.frf, freq_hz=fit.freq_hz[k0], response=fit.meas[k0], metadata=dict(c0.frf.metadata))
+    try:
+        result.mbi, res, E = _identify_at(d.model_text, d.path, at, seen, c0.in_name, c0.out_name,
+                                          progress=lambda stage, frac: tell(
+                                              f"model-based identification: {stage}", 0.97 + 0.02 * frac))
+    except ModelError as exc:
+        result.mbi = {"location": None, "reading": f"not run: {exc}", "agrees": None}
+    else:
+        if at is not verdict:
+            # nothing the hypotheses name explains the data: K itself becomes the element of the model
+            tell("the controller as an element of the model, judged on the held-out data", 0.99)
+            try:
+                result.mbi.update(mbi_element(result.mbi, res, E, d.model_text, d.eng, localized["station"],
+                                              localized["dof"], d.rec, d.held, d.s2, d.ref, alpha, seen,
+                                              c0.in_name, c0.out_name, err_before))
+            except ModelError as exc:
+                result.mbi["element"] = None
+                result.notes.append(f"the controller was not written as an element: {exc}")
+    result.seconds = time.perf_counter() - t0
+
+
 
 
 def _channel_at(chans, station: int) -> int:
@@ -454,36 +549,6 @@ def _group_unmatched(rows: list) -> list:
     return out
 
 
-def _judge(f: Finding, N: int, threshold: float) -> None:
-    """Significance as the name says: the improvement passes the test against the larger of the noise and
-    what the hypothesis itself leaves (an F test when the residual is above the noise), and the size
-    does not sit at a bound of its range."""
-    if f.kind == "none" or f.hypothesis is None:
-        return
-    h = f.hypothesis
-    f.at_bound = bool(f.delta_chi2 > 0 and at_bound(h, f.value if f.values is None else f.values))
-    k = h.n_params
-    left = max(1.0, (f.score - k * math.log(N)) / max(N - k, 1))
-    f.significant = bool(f.delta_chi2 / left > threshold_k(threshold, k) and not f.at_bound)
-
-
-def _status(effects, quality, gain, held_quality) -> str:
-    """Explained: the fitted and the held-out data at the noise (and, with effects, the held-out data better
-    than before); partly: effects that help on held-out data, a residual above the noise; otherwise not
-    explained."""
-    # a channel's scale acts on its own file only: other files cannot confirm it, only not contradict it
-    better = gain > 1 or (bool(effects) and all(e.kind == "channel_scale" for e in effects) and gain >= 1 - 1e-9)
-    if quality.at_noise and held_quality.at_noise:
-        return "explained" if (not effects or better) else "not explained"
-    return "partly explained" if (effects and better) else "not explained"
-
-
-def _in_model_file(f) -> bool:
-    """Whether a finding is a structural change written into the model file (not a correction of the data)."""
-    h = f.hypothesis
-    return f.kind != "none" and h is not None and h.gain is None and h.glob is None
-
-
 def _quality_of_file(verdict, model_text, eng, path, rec, chans, all_fit, held, s2, ref, alpha):
     """The lack-of-fit test of the extended model file itself, on every fitted line."""
     text = extended_model_text(model_text, verdict, eng)
@@ -492,183 +557,6 @@ def _quality_of_file(verdict, model_text, eng, path, rec, chans, all_fit, held, 
         r = [np.log(h / m) for h, m in zip(after_all, all_fit.meas)]
     return fit_quality(r, all_fit.freq_hz, [c.label for c in all_fit.chans], s2, verdict.hypothesis.n_params, ref,
                        alpha)
-
-
-def _select_more(effects, hyps, rec, fit, held, s2, N, threshold, alpha, ref, notes, tell, first=None):
-    """Forward selection (see :mod:`mutext.diagnose._select`): returns (effects, fit quality of the last model).
-
-    ``first``: the fit quality of the first effect when it is judged on the model file itself."""
-    labels = [c.label for c in fit.chans]
-
-    def quality_of(effs, thetas):
-        Hs = Compound(rec, fit, [e.hypothesis for e in effs]).responses(thetas) if effs else fit.H0
-        with np.errstate(all="ignore"):
-            r = [np.log(h / m) for h, m in zip(Hs, fit.meas)]
-        return fit_quality(r, fit.freq_hz, labels, s2, len(effs), ref, alpha)
-
-    thetas = [e.theta for e in effects]
-    quality = first if first is not None else quality_of(effects, thetas)
-    chi_held = float(sst.chi2.isf(alpha, 1))
-    while effects and not quality.at_noise and len(effects) < MAX_EFFECTS:
-        tell(f"the residual is above the noise: screening a further effect given {len(effects)}", 0.9)
-        base = [e.hypothesis for e in effects]
-        rss_a = _rss_of(Compound(rec, fit, base).responses(thetas), fit.meas)
-        held_a = _rss_of(Compound(rec, held, base).responses(thetas), held.meas)
-        if held_a > _rss_of(held.H0, held.meas):
-            notes.append(f"no further effect searched: the {len(effects)} effect(s) found make the held-out data "
-                         "worse")
-            break
-        cands = []
-        for h in hyps:
-            if any(h is b for b in base) or h.params:      # a k-parameter kind is found first or not at all
-                continue
-            t, r = fit_one_given(rec, fit, base, thetas, h)
-            cands.append((r, id(h), h, t))
-        if not cands:
-            break
-        cands.sort(key=lambda x: x[:2])
-        # the best few, fitted jointly with those accepted; of them the best that passes every test (a channel's
-        # scale and a sensor's gain can tie on the fitted data and part on the held-out data)
-        tried = []
-        for r, _, h, t in cands[:4]:
-            hs = base + [h]
-            th, rss_new, sd = joint_fit(rec, fit, hs, thetas + [t], s2)
-            hs, th, rss_new, sd = _nested_at_bound(hs, th, rss_new, sd, hyps, rec, fit, s2, notes)
-            dchi = (rss_a - rss_new) / s2
-            held_new = _rss_of(Compound(rec, held, hs).responses(th), held.meas)
-            dheld = (held_a - held_new) / s2
-            stuck = [x.description for x, tt in zip(hs, th) if at_bound(x, tt)]
-            left = max(1.0, rss_new / (s2 * max(N - sum(x.n_params for x in hs), 1)))
-            # an effect on one fitted file only (its scale) cannot show on other files: not held against them
-            own_file_only = held_new == held_a and h.kind == "channel_scale"
-            ok = dchi / left > threshold and (dheld > chi_held or own_file_only) and not stuck
-            tried.append((not ok, rss_new, h, th, sd, dchi, dheld, stuck, left, hs))
-        tried.sort(key=lambda x: (x[0], x[1]))
-        failed, rss_new, h, th, sd, dchi, dheld, stuck, left, hs = tried[0]
-        if failed:
-            why = ("a size at the bound of its range: " + ", ".join(stuck)) if stuck else (
-                f"delta chi2 {dchi:.1f} on the fitted data (threshold {threshold:.1f}"
-                + (f", {threshold * left:.1f} against the misfit left" if left > 1 else "")
-                + f"), {dheld:.1f} on the held-out data (threshold {chi_held:.1f})")
-            notes.append(f"no further effect accepted; the best candidate, {h.description}, given "
-                         f"{len(effects)} effect(s): {why}")
-            break
-        new = _findings_of(hs, th, sd, rss_new, s2, N, [e.delta_chi2 for e in effects] + [dchi])
-        effects = _drop_redundant(new, rec, fit, s2, N, threshold, notes)
-        thetas = [e.theta for e in effects]
-        quality = quality_of(effects, thetas)
-    if len(effects) > 1:
-        simpler = _simplify(effects, hyps, rec, fit, s2, N, threshold, notes)
-        if simpler is not effects:
-            effects = simpler
-            quality = quality_of(effects, [e.theta for e in effects])
-    return effects, quality
-
-
-def _findings_of(hs, th, sd, rss, s2, N, delta_chi2s):
-    """Findings for the jointly fitted hypotheses ``hs`` at sizes ``th`` with stds ``sd``."""
-    n_par = sum(x.n_params for x in hs)
-    out = []
-    for x, t, d, dchi in zip(hs, th, sd, delta_chi2s):
-        vec = np.ndim(t) > 0
-        t0, d0 = (float(t[0]), float(d[0])) if vec else (float(t), float(d))
-        f = Finding(x.kind, x.station, x.element, t0, x.unit, d0, rss / s2 + n_par * math.log(N), float(dchi),
-                    x.description, True, False, None if (x.gain is not None or x.added) else x.nominal + t0, x)
-        if vec:
-            f.values, f.stds = tuple(float(v) for v in t), tuple(float(v) for v in d)
-        out.append(f)
-    return out
-
-
-def _drop_redundant(effects, rec, fit, s2, N, threshold, notes):
-    """The backward step of the selection: an earlier effect that the later ones make unnecessary is dropped.
-
-    A first effect can stand in for two (a common loss of all springs imitates one weaker spring and a
-    heavier roof); once those two are in, the stand-in's joint size is noise.  Each effect but the newest
-    (which has just passed its test given the others) is removed in turn and the rest refitted jointly; the
-    one whose removal costs least is dropped when that cost is below the threshold of its parameter count,
-    against the misfit left, and the step repeats."""
-    while len(effects) > 1:
-        hs, th = [e.hypothesis for e in effects], [e.theta for e in effects]
-        full = _rss_of(Compound(rec, fit, hs).responses(th), fit.meas)
-        left = max(1.0, full / (s2 * max(N - sum(h.n_params for h in hs), 1)))
-        best = None
-        for k, e in enumerate(effects[:-1]):
-            rest, rest_th = hs[:k] + hs[k + 1:], th[:k] + th[k + 1:]
-            th2, rss2, sd2 = joint_fit(rec, fit, rest, rest_th, s2)
-            cost = (rss2 - full) / s2 / left
-            if cost < threshold_k(threshold, e.hypothesis.n_params) and (best is None or cost < best[0]):
-                best = (cost, k, rest, th2, rss2, sd2)
-        if best is None:
-            return effects
-        cost, k, rest, th2, rss2, sd2 = best
-        notes.append(f"{effects[k].description} dropped: given the later effects it improves the fit by delta "
-                     f"chi2 {cost:.1f} only (threshold {threshold_k(threshold, effects[k].hypothesis.n_params):.1f})")
-        kept = effects[:k] + effects[k + 1:]
-        effects = _findings_of(rest, th2, sd2, rss2, s2, N, [e.delta_chi2 for e in kept])
-    return effects
-
-
-def _nested_at_bound(hs, th, rss, sd, hyps, rec, fit, s2, notes):
-    """A k-parameter effect that a joint fit drives to a bound of a parameter (an absorber's spring to its
-    stiffest: a mass) replaced by its nested one-parameter reading (``Hypothesis.nested``), refitted jointly.
-    Returns ``(hypotheses, sizes, rss, stds)``, unchanged when there is nothing to replace."""
-    for j, x in enumerate(hs):
-        if not (x.params and x.nested and at_bound(x, th[j])):
-            continue
-        g = next((y for y in hyps if (y.kind, y.element) == x.nested[0]), None)
-        if g is None or any(g is y for y in hs):
-            continue
-        rest, rest_th = hs[:j] + hs[j + 1:], th[:j] + th[j + 1:]
-        t0, _ = fit_one_given(rec, fit, rest, rest_th, g)
-        hs2 = hs[:j] + [g] + hs[j + 1:]
-        th2, rss2, sd2 = joint_fit(rec, fit, hs2, th[:j] + [t0] + th[j + 1:], s2)
-        notes.append(f"{x.description} reached the bound of a parameter given the other effects: read as "
-                     f"{g.description} (its limit) and refitted")
-        return hs2, th2, rss2, sd2
-    return hs, th, rss, sd
-
-
-def _simplify(effects, hyps, rec, fit, s2, N, threshold, notes):
-    """Effects with a k-parameter one replaced by its nested one-parameter reading (``Hypothesis.nested``) when,
-    fitted jointly with the others, the simpler reading is not worse by more than the chi2_(k-1) threshold
-    (a pedestal whose mass the joint fit leaves at zero is a softer spring).  Returns ``effects`` itself when
-    nothing is replaced."""
-    n_par = sum(e.hypothesis.n_params for e in effects)
-    full = _rss_of(Compound(rec, fit, [e.hypothesis for e in effects]).responses([e.theta for e in effects]),
-                   fit.meas)
-    left = max(1.0, full / (s2 * max(N - n_par, 1)))
-    for k, e in enumerate(effects):
-        h = e.hypothesis
-        if not h.params or not h.nested:
-            continue
-        others = [x for j, x in enumerate(effects) if j != k]
-        base, th = [x.hypothesis for x in others], [x.theta for x in others]
-        for key in h.nested:
-            g = next((x for x in hyps if (x.kind, x.element) == key), None)
-            if g is None:
-                continue
-            t, _ = fit_one_given(rec, fit, base, th, g)
-            th2, rss2, sd2 = joint_fit(rec, fit, base + [g], th + [t], s2)
-            if (rss2 - full) / s2 / left >= threshold_k(threshold, h.n_params - 1):
-                continue
-            notes.append(f"{h.description} reads as {g.description} given the other effects (its "
-                         f"{h.n_params - 1} further parameter(s) improve the fit by delta chi2 "
-                         f"{(rss2 - full) / s2:.1f} only): the simpler reading is kept")
-            score = rss2 / s2 + (n_par - h.n_params + 1) * math.log(N)
-            out = []
-            for x, t2, d2 in zip(others + [None], th2, sd2):
-                xh = g if x is None else x.hypothesis
-                vec = np.ndim(t2) > 0
-                t0, d0 = (float(t2[0]), float(d2[0])) if vec else (float(t2), float(d2))
-                f = Finding(xh.kind, xh.station, xh.element, t0, xh.unit, d0, score,
-                            e.delta_chi2 if x is None else x.delta_chi2, xh.description, True, False,
-                            None if (xh.gain is not None or xh.added) else xh.nominal + t0, xh)
-                if vec:
-                    f.values, f.stds = tuple(float(v) for v in t2), tuple(float(v) for v in d2)
-                out.append(f)
-            return out[:k] + [out[-1]] + out[k:-1]
-    return effects
 
 
 def _data_sets(rec, allf, chans, vchans):
@@ -774,37 +662,6 @@ def _refit_best(findings, refit, model_text, path, eng, fit, s2, N, rss0, thresh
     return notes
 
 
-def _decide(findings, none, threshold, N, rec, fit, eng, notes, held, s2):
-    """The verdict (the best significant hypothesis, or none), those it cannot be told from, and the
-    sensor station that would separate them; notes are appended to ``notes``.
-
-    Among hypotheses the fitted data cannot tell apart, the held-out data decide when they can (one
-    fits them better by more than chi2_1(0.95) noise units): e.g. a sensor's gain and the scale of its
-    one fitted file are the same on the fitted data, not on other files of that sensor."""
-    best = next((f for f in findings if f.kind != "none" and not f.at_bound),
-                next(f for f in findings if f.kind != "none"))
-    verdict = best if best.significant else none
-    if verdict is none:
-        if best.delta_chi2 > 0:
-            notes.append(f"best hypothesis ({best.description}) improves the fit by delta chi2 = "
-                         f"{best.delta_chi2:.1f}, below the threshold {threshold:.1f}")
-        return verdict, [], None
-    tie = float(sst.chi2.isf(0.05, 1))
-    ambiguous = [f for f in findings if f is not verdict and f.kind != "none" and f.significant
-                 and (f.score - verdict.score) < tie]
-    if ambiguous:
-        held_rss = {id(f): _rss_of(Compound(rec, held, [f.hypothesis]).responses([f.theta]), held.meas)
-                    for f in [verdict] + ambiguous}
-        alt = min(ambiguous, key=lambda f: held_rss[id(f)])
-        if (held_rss[id(verdict)] - held_rss[id(alt)]) / s2 > tie:
-            notes.append(f"{alt.description} and {verdict.description} fit the fitted data equally; the "
-                         f"held-out data prefer {alt.description}")
-            ambiguous = [verdict] + [f for f in ambiguous if f is not alt]
-            verdict = alt
-    sensor = _separating_station(rec, fit, [verdict] + ambiguous, eng) if ambiguous else None
-    return verdict, ambiguous, sensor
-
-
 def _after(verdict, text, path, rec, chans, all_fit, held):
     """Responses of the extended model on the fitted channels and on the held-out data."""
     if verdict.kind == "none":
@@ -818,17 +675,3 @@ def _after(verdict, text, path, rec, chans, all_fit, held):
             [model_response(ext, c.frf, freq_hz=fs) for c, fs in zip(held.chans, held.freq_hz)])
 
 
-def _finding(h, theta, std, rss, rss0, s2, N, threshold) -> Finding:
-    dchi = (rss0 - rss) / s2
-    new = None
-    if h.gain is None and not h.added:
-        new = h.nominal + theta
-    return Finding(h.kind, h.station, h.element, float(theta), h.unit, float(std),
-                   rss / s2 + h.n_params * math.log(N), float(dchi), h.description,
-                   bool(dchi > threshold_k(threshold, h.n_params)), False, new, h)
-
-
-def threshold_k(threshold: float, k: int) -> float:
-    """The delta chi2 threshold of a k-parameter hypothesis at the false-alarm rate of the one-parameter
-    ``threshold`` (the same tail probability of chi2 with k degrees of freedom)."""
-    return threshold if k == 1 else float(sst.chi2.isf(sst.chi2.sf(threshold, 1), k))

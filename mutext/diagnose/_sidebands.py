@@ -312,6 +312,42 @@ def sideband_evidence(frfs, natural_frequencies_hz, speed_hz: float, *, orders=(
     SidebandEvidence
     """
     from ..frfit import noise_level
+    combos, mains, f, Hs, orders = _checked_data(frfs, speed_hz, orders, alpha)
+    if noise is None:
+        noise = float(np.median([noise_level(f, H) for H in Hs]))
+    noise = max(float(noise), 1e-12)
+    df = float(np.median(np.diff(f)))
+    F = float(speed_hz)
+    # the modes, refined on the data (the largest channel)
+    ref = Hs[int(np.argmax([np.max(np.abs(H)) for H in Hs]))]
+    modes = _data_modes(f, ref, noise, _clusters(natural_frequencies_hz), F * max(orders))
+    cands = _candidates(modes, orders, f, F, df)
+    tested = [c for c in cands if not c.masked]
+    threshold = alpha / max(len(tested), 1)
+    for c in tested:
+        _test_candidate(c, cands, modes, f, Hs, F, df, noise, threshold)
+    _mark_unpaired(cands)
+    found = sorted({abs(c.k) for c in cands if c.found and not c.unpaired})
+    verdict = ("once per revolution" if (1 in found or 3 in found) else
+               "twice per revolution" if 2 in found else "none")
+    n_win = max(8, int(round(2 * 2.5 / df)))
+    detectable = noise * float(np.sqrt(stats.chi2.isf(threshold, 2) / n_win)) * 2.0
+    ev = SidebandEvidence(cands, [(float(a), float(b)) for a, b in modes], F, noise, threshold, found,
+                          verdict, detectable, stepped_sine_verdict=verdict)
+    if combos:
+        ev.combination = _combination_tests(combos, mains, modes, noise, alpha)
+        ks = sorted({abs(c.k) for c in ev.combination if c.found and c.consistent})
+        ev.orders_found = ks
+        ev.verdict = ("once per revolution" if (1 in ks or 3 in ks) else
+                      "twice per revolution" if 2 in ks else "none")
+        ev.source = "combination"
+        ev.threshold = alpha / len(ev.combination)
+    return ev
+
+
+def _checked_data(frfs, speed_hz, orders, alpha):
+    """The arguments of :func:`sideband_evidence` checked: ``(combination FRFs, excitation-frequency FRFs,
+    frequency grid, responses of the channels at ``speed_hz``, sorted positive orders)``."""
     everything = _as_list(frfs)
     combos = [d for d in everything if frf_order(d) != 0]
     mains = [d for d in everything if frf_order(d) == 0]
@@ -336,12 +372,11 @@ def sideband_evidence(frfs, natural_frequencies_hz, speed_hz: float, *, orders=(
     if f.size < 20:
         raise ModelError(f"sideband_evidence: need at least 20 frequencies, got {f.size}")
     Hs = [np.asarray(d.response, complex) for d in data]
-    if noise is None:
-        noise = float(np.median([noise_level(f, H) for H in Hs]))
-    noise = max(float(noise), 1e-12)
-    df = float(np.median(np.diff(f)))
-    F = float(speed_hz)
-    # the modes, refined on the data (the largest channel)
+    return combos, mains, f, Hs, orders
+
+
+def _clusters(natural_frequencies_hz) -> list:
+    """The given natural frequencies (finite, positive), sorted, those within 1 % of each other grouped."""
     fn_in = np.sort(np.asarray(natural_frequencies_hz, float).ravel())
     fn_in = fn_in[np.isfinite(fn_in) & (fn_in > 0)]
     clusters = []
@@ -350,8 +385,12 @@ def sideband_evidence(frfs, natural_frequencies_hz, speed_hz: float, *, orders=(
             clusters[-1].append(x)
         else:
             clusters.append([x])
-    ref = Hs[int(np.argmax([np.max(np.abs(H)) for H in Hs]))]
-    modes = _data_modes(f, ref, noise, clusters, F * max(orders))
+    return clusters
+
+
+def _candidates(modes, orders, f, F, df) -> list:
+    """A :class:`SidebandCandidate` for each mode and order ``-/+k`` whose sideband falls inside the band,
+    marked masked when a mode of its own frequency hides it."""
     cands = []
     for fn, z in modes:
         for k in orders:
@@ -363,69 +402,59 @@ def sideband_evidence(frfs, natural_frequencies_hz, speed_hz: float, *, orders=(
                 # masked by a mode of its own frequency (within 3 half-power bandwidths, or 3 samples)
                 c.masked = any(abs(fc - fm) < max(3.0 * zm * fm, 3 * df) for fm, zm in modes)
                 cands.append(c)
-    tested = [c for c in cands if not c.masked]
-    threshold = alpha / max(len(tested), 1)
-    for c in tested:
-        zn = dict(modes)[c.mode_hz]
-        half = max(2.5, 4.0 * zn * c.mode_hz, 6 * df)
-        sel = (f >= c.freq_hz - half) & (f <= c.freq_hz + half)
-        if sel.sum() < 8:
-            c.masked = True
-            continue
-        fs = f[sel]
-        base = [np.ones_like(fs), fs - c.freq_hz]
-        for fm, zm in modes:
-            if abs(fm - c.freq_hz) < half + 40 * zm * fm + 3 * F:
-                # the shape and its derivatives in f_n and zeta: small errors of the mode's
-                # parameters are absorbed linearly instead of being read as a sideband
-                Dn = fm * fm - fs * fs + 2j * zm * fm * fs
-                base += [1.0 / Dn, (2 * fm + 2j * zm * fs) / Dn**2, (2j * fm * fs) / Dn**2]
-        side = _shape(fs + c.k * F, c.mode_hz, zn)
-        # other candidates whose sideband falls in this window stay in both fits, so that a
-        # strong neighbour is not read as this one (a drop-one test)
-        zmap = dict(modes)
-        base += [_shape(fs + o.k * F, o.mode_hz, zmap[o.mode_hz]) for o in cands
-                 if o is not c and abs(o.freq_hz - c.freq_hz) < half and abs(o.freq_hz - c.freq_hz) > 2 * df]
-        d2, sizes = 0.0, []
-        for H in Hs:
-            y = H[sel]
-            wt = 1.0 / (noise * np.maximum(np.abs(y), 1e-300))     # sigma_i = noise * |H_i|
-            X0 = np.column_stack(base) * wt[:, None]
-            X1 = np.column_stack(base + [side]) * wt[:, None]
-            r0 = y * wt - X0 @ np.linalg.lstsq(X0, y * wt, rcond=None)[0]
-            coef1 = np.linalg.lstsq(X1, y * wt, rcond=None)[0]
-            r1 = y * wt - X1 @ coef1
-            # circular complex noise: |n|^2 / (sigma^2 / 2) is chi-square with 2 degrees of freedom
-            d2 += 2.0 * float(np.sum(np.abs(r0) ** 2) - np.sum(np.abs(r1) ** 2))
-            sizes.append(float(np.max(np.abs(coef1[-1] * side) / np.maximum(np.abs(y), 1e-300))))
-        c.delta_chi2 = d2
-        c.p_value = float(stats.chi2.sf(max(d2, 0.0), 2 * len(Hs)))
-        c.relative_size = float(max(sizes))
-        c.snr = c.relative_size / noise
-        c.found = bool(c.p_value < threshold)
-    # a sideband comes with its mirror image about the mode (f_n - kF and f_n + kF): one found alone,
-    # its partner testable and not found, is more likely a mode the model misplaces than a sideband
+    return cands
+
+
+def _test_candidate(c, cands, modes, f, Hs, F, df, noise, threshold) -> None:
+    """The drop-one test of the candidate ``c`` in a window around it, on every channel: its delta chi2,
+    p-value, size and whether it is found are set on ``c`` (or it is marked masked: too few samples)."""
+    zn = dict(modes)[c.mode_hz]
+    half = max(2.5, 4.0 * zn * c.mode_hz, 6 * df)
+    sel = (f >= c.freq_hz - half) & (f <= c.freq_hz + half)
+    if sel.sum() < 8:
+        c.masked = True
+        return
+    fs = f[sel]
+    base = [np.ones_like(fs), fs - c.freq_hz]
+    for fm, zm in modes:
+        if abs(fm - c.freq_hz) < half + 40 * zm * fm + 3 * F:
+            # the shape and its derivatives in f_n and zeta: small errors of the mode's
+            # parameters are absorbed linearly instead of being read as a sideband
+            Dn = fm * fm - fs * fs + 2j * zm * fm * fs
+            base += [1.0 / Dn, (2 * fm + 2j * zm * fs) / Dn**2, (2j * fm * fs) / Dn**2]
+    side = _shape(fs + c.k * F, c.mode_hz, zn)
+    # other candidates whose sideband falls in this window stay in both fits, so that a
+    # strong neighbour is not read as this one (a drop-one test)
+    zmap = dict(modes)
+    base += [_shape(fs + o.k * F, o.mode_hz, zmap[o.mode_hz]) for o in cands
+             if o is not c and abs(o.freq_hz - c.freq_hz) < half and abs(o.freq_hz - c.freq_hz) > 2 * df]
+    d2, sizes = 0.0, []
+    for H in Hs:
+        y = H[sel]
+        wt = 1.0 / (noise * np.maximum(np.abs(y), 1e-300))     # sigma_i = noise * |H_i|
+        X0 = np.column_stack(base) * wt[:, None]
+        X1 = np.column_stack(base + [side]) * wt[:, None]
+        r0 = y * wt - X0 @ np.linalg.lstsq(X0, y * wt, rcond=None)[0]
+        coef1 = np.linalg.lstsq(X1, y * wt, rcond=None)[0]
+        r1 = y * wt - X1 @ coef1
+        # circular complex noise: |n|^2 / (sigma^2 / 2) is chi-square with 2 degrees of freedom
+        d2 += 2.0 * float(np.sum(np.abs(r0) ** 2) - np.sum(np.abs(r1) ** 2))
+        sizes.append(float(np.max(np.abs(coef1[-1] * side) / np.maximum(np.abs(y), 1e-300))))
+    c.delta_chi2 = d2
+    c.p_value = float(stats.chi2.sf(max(d2, 0.0), 2 * len(Hs)))
+    c.relative_size = float(max(sizes))
+    c.snr = c.relative_size / noise
+    c.found = bool(c.p_value < threshold)
+
+
+def _mark_unpaired(cands) -> None:
+    """A sideband comes with its mirror image about the mode (f_n - kF and f_n + kF): one found alone, its
+    partner testable and not found, is more likely a mode the model misplaces than a sideband."""
     def paired(c):
         partner = next((o for o in cands if o.mode_hz == c.mode_hz and o.k == -c.k), None)
         return partner is None or partner.masked or partner.found
     for c in cands:
         c.unpaired = bool(c.found and not paired(c))
-    found = sorted({abs(c.k) for c in cands if c.found and not c.unpaired})
-    verdict = ("once per revolution" if (1 in found or 3 in found) else
-               "twice per revolution" if 2 in found else "none")
-    n_win = max(8, int(round(2 * 2.5 / df)))
-    detectable = noise * float(np.sqrt(stats.chi2.isf(threshold, 2) / n_win)) * 2.0
-    ev = SidebandEvidence(cands, [(float(a), float(b)) for a, b in modes], F, noise, threshold, found,
-                          verdict, detectable, stepped_sine_verdict=verdict)
-    if combos:
-        ev.combination = _combination_tests(combos, mains, modes, noise, alpha)
-        ks = sorted({abs(c.k) for c in ev.combination if c.found and c.consistent})
-        ev.orders_found = ks
-        ev.verdict = ("once per revolution" if (1 in ks or 3 in ks) else
-                      "twice per revolution" if 2 in ks else "none")
-        ev.source = "combination"
-        ev.threshold = alpha / len(ev.combination)
-    return ev
 
 
 def _same_channel(a, b) -> bool:
