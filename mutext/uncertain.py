@@ -363,6 +363,29 @@ def uncertain_mck(matrices: Callable[[Mapping[str, float]], tuple], params: Sequ
     >>> U.structure
     BlockStructure[real x1 m, real x1 k]
     """
+    params = _checked_ports(params, inputs, outputs)
+    evaluate = _mck_evaluator(matrices, [p.name for p in params])
+    center = {p.name: p.center for p in params}
+    N0 = evaluate(center)
+    ndof = N0.shape[0]
+    K0, C0, M0 = N0[:, :ndof], N0[:, ndof:2 * ndof], N0[:, 2 * ndof:]
+    Ns = _unit_changes(evaluate, params, center, N0)
+    _check_affine(evaluate, params, center, N0, Ns, affine_tol, rng)
+    _check_mass(M0, Ns, params, ndof)
+    P, reps = _mck_lft(K0, C0, M0, Ns, params, inputs, outputs, dof_names)
+    structure = BlockStructure([Block.real(r, p.name) for p, r in zip(params, reps)])
+    inputs, outputs = dict(inputs), dict(outputs)
+
+    def build(values):
+        Nv = evaluate(values)
+        return mck_to_ss(Nv[:, 2 * ndof:], Nv[:, ndof:2 * ndof], Nv[:, :ndof], inputs, outputs,
+                         dof_names=dof_names)
+
+    return UncertainModel(P, structure, params, build, tuple(reps))
+
+
+def _checked_ports(params, inputs, outputs) -> tuple:
+    """The parameters as a tuple, once there is at least one, with unique names, and ports on both sides."""
     params = tuple(params)
     if not params:
         raise ModelError("at least one uncertain parameter is needed")
@@ -371,7 +394,12 @@ def uncertain_mck(matrices: Callable[[Mapping[str, float]], tuple], params: Sequ
         raise ModelError(f"parameter names must be unique, got {names}")
     if not inputs or not outputs:
         raise ModelError("at least one input and one output port are needed")
+    return params
 
+
+def _mck_evaluator(matrices, names):
+    """``evaluate(values) -> [K C M]`` from the user's ``matrices(values) -> (M, C, K)``, checked (sizes,
+    finite entries, only the parameters ``names`` asked for)."""
     def evaluate(values):
         try:
             out = matrices(dict(values))
@@ -395,17 +423,18 @@ def uncertain_mck(matrices: Callable[[Mapping[str, float]], tuple], params: Sequ
                 raise ModelError(f"{nm} contains non-finite entries at parameter values "
                                  f"{ {k: float(v) for k, v in values.items()} }")
         return np.hstack([K, C, M])
+    return evaluate
 
-    def where(N):
-        """Names of the matrices (M, C, K) in which N = [K C M] is nonzero."""
-        n = N.shape[0]
-        return [nm for nm, X in (("K", N[:, :n]), ("C", N[:, n:2 * n]), ("M", N[:, 2 * n:]))
-                if np.abs(X).max() > 0]
 
-    center = {p.name: p.center for p in params}
-    N0 = evaluate(center)
-    ndof = N0.shape[0]
-    K0, C0, M0 = N0[:, :ndof], N0[:, ndof:2 * ndof], N0[:, 2 * ndof:]
+def _where(N):
+    """Names of the matrices (M, C, K) in which N = [K C M] is nonzero."""
+    n = N.shape[0]
+    return [nm for nm, X in (("K", N[:, :n]), ("C", N[:, n:2 * n]), ("M", N[:, 2 * n:]))
+            if np.abs(X).max() > 0]
+
+
+def _unit_changes(evaluate, params, center, N0) -> list:
+    """The change of [K C M] when each parameter alone goes to the edge of its range (delta = 1)."""
     Ns = []
     for p in params:
         v = dict(center)
@@ -414,8 +443,12 @@ def uncertain_mck(matrices: Callable[[Mapping[str, float]], tuple], params: Sequ
         if np.abs(Ni).max() == 0:
             raise ModelError(f"parameter {p.name} does not change M, C or K (does matrices() use it?)")
         Ns.append(Ni)
-    # affinity: each parameter alone (curvature at delta = -1 and 1/2, which names the
-    # culprit), then all together at random points (products of parameters)
+    return Ns
+
+
+def _check_affine(evaluate, params, center, N0, Ns, affine_tol, rng) -> None:
+    """Affinity: each parameter alone (curvature at delta = -1 and 1/2, which names the culprit), then all
+    together at random points of the generator or seed ``rng`` (products of parameters)."""
     rng = np.random.default_rng(rng)
     scale = max(np.abs(N0).max(), max(np.abs(N).max() for N in Ns))
     for p, Ni in zip(params, Ns):
@@ -425,7 +458,7 @@ def uncertain_mck(matrices: Callable[[Mapping[str, float]], tuple], params: Sequ
             dev = evaluate(v) - N0 - x * Ni
             err = np.abs(dev).max()
             if err > affine_tol * scale:
-                raise ModelError(f"{'/'.join(where(dev))} not affine in parameter {p.name} (deviation "
+                raise ModelError(f"{'/'.join(_where(dev))} not affine in parameter {p.name} (deviation "
                                  f"{err:.3g} at {p.name} = {p.value(x):.6g}); rewrite the model so that "
                                  "every entry is affine in the uncertain parameters (e.g. use 1/m as "
                                  "the parameter)")
@@ -435,10 +468,15 @@ def uncertain_mck(matrices: Callable[[Mapping[str, float]], tuple], params: Sequ
         dev = Nd - N0 - sum(x * N for x, N in zip(d, Ns))
         err = np.abs(dev).max()
         if err > affine_tol * scale:
-            raise ModelError(f"{'/'.join(where(dev))} not affine in the parameters jointly (deviation "
+            raise ModelError(f"{'/'.join(_where(dev))} not affine in the parameters jointly (deviation "
                              f"{err:.3g} at delta = {np.round(d, 3).tolist()} for "
                              f"{[p.name for p in params]}): products of parameters cannot be written "
                              "with one real block per parameter")
+
+
+def _check_mass(M0, Ns, params, ndof) -> None:
+    """The nominal mass matrix symmetric positive definite, and positive definite at every corner of the
+    box of the parameters that enter it."""
     if not np.allclose(M0, M0.T, rtol=1e-10, atol=0):
         raise ModelError("the nominal mass matrix M is not symmetric")
     try:
@@ -457,7 +495,11 @@ def uncertain_mck(matrices: Callable[[Mapping[str, float]], tuple], params: Sequ
                 corner = {params[i].name: params[i].value(sg) for sg, i in zip(signs, in_m)}
                 raise ModelError(f"the mass matrix is not positive definite at {corner}: the "
                                  "uncertainty ranges of the masses are too wide") from None
-    # build the LFT
+
+
+def _mck_lft(K0, C0, M0, Ns, params, inputs, outputs, dof_names):
+    """The LFT's plant ``[w, u] -> [z, y]`` of the nominal matrices and the factored changes ``Ns``:
+    ``(plant, repetitions of each parameter's block)``."""
     Ls, Rs, reps = [], [], []
     for p, Ni in zip(params, Ns):
         L, R = _factor(Ni)
@@ -466,6 +508,7 @@ def uncertain_mck(matrices: Callable[[Mapping[str, float]], tuple], params: Sequ
         reps.append(L.shape[1])
     L = np.hstack(Ls)
     R = np.vstack(Rs)
+    ndof = M0.shape[0]
     nunc = L.shape[1]
     F = np.column_stack([_port_vector(pv, ndof, f"input '{n}'") for n, pv in inputs.items()])
     Mi = np.linalg.inv(M0)
@@ -479,6 +522,22 @@ def uncertain_mck(matrices: Callable[[Mapping[str, float]], tuple], params: Sequ
     Cz = np.hstack([RK, RC]) + RM @ Aacc
     Dzw = RM @ Baw
     Dzu = RM @ Bau
+    Cy, Dyw, Dyu = _output_rows(outputs, ndof, Aacc, Baw, Bau, nunc, F.shape[1])
+    wn, zn = [], []
+    for p, r in zip(params, reps):
+        sfx = [""] if r == 1 else [f"_{j + 1}" for j in range(r)]
+        wn += [f"w_{p.name}{s}" for s in sfx]
+        zn += [f"z_{p.name}{s}" for s in sfx]
+    dn = list(dof_names) if dof_names is not None else [f"q{i + 1}" for i in range(ndof)]
+    P = ss(A, np.hstack([Bw, Bu]), np.vstack([Cz, Cy]),
+           np.block([[Dzw, Dzu], [Dyw, Dyu]]),
+           inputs=wn + list(inputs), outputs=zn + list(outputs), states=dn + [f"d{n}" for n in dn])
+    return P, reps
+
+
+def _output_rows(outputs, ndof, Aacc, Baw, Bau, nunc, nin):
+    """``(C_y, D_yw, D_yu)`` of the output ports (displacement, velocity or acceleration of a DOF or a
+    combination of DOFs); ``Aacc``, ``Baw``, ``Bau``: the acceleration's rows of the state equation."""
     rowsC, rowsDw, rowsDu = [], [], []
     for n_, pv in outputs.items():
         if isinstance(pv, tuple) and len(pv) == 2 and isinstance(pv[0], str):
@@ -489,33 +548,15 @@ def uncertain_mck(matrices: Callable[[Mapping[str, float]], tuple], params: Sequ
         if q == "displacement":
             rowsC.append(np.concatenate([v, np.zeros(ndof)]))
             rowsDw.append(np.zeros(nunc))
-            rowsDu.append(np.zeros(F.shape[1]))
+            rowsDu.append(np.zeros(nin))
         elif q == "velocity":
             rowsC.append(np.concatenate([np.zeros(ndof), v]))
             rowsDw.append(np.zeros(nunc))
-            rowsDu.append(np.zeros(F.shape[1]))
+            rowsDu.append(np.zeros(nin))
         elif q == "acceleration":
             rowsC.append(v @ Aacc)
             rowsDw.append(v @ Baw)
             rowsDu.append(v @ Bau)
         else:
             raise ModelError(f"output '{n_}': unknown quantity {q!r}")
-    Cy, Dyw, Dyu = np.array(rowsC), np.array(rowsDw).reshape(-1, nunc), np.array(rowsDu)
-    wn, zn = [], []
-    for p, r in zip(params, reps):
-        sfx = [""] if r == 1 else [f"_{j + 1}" for j in range(r)]
-        wn += [f"w_{p.name}{s}" for s in sfx]
-        zn += [f"z_{p.name}{s}" for s in sfx]
-    dn = list(dof_names) if dof_names is not None else [f"q{i + 1}" for i in range(ndof)]
-    P = ss(A, np.hstack([Bw, Bu]), np.vstack([Cz, Cy]),
-           np.block([[Dzw, Dzu], [Dyw, Dyu]]),
-           inputs=wn + list(inputs), outputs=zn + list(outputs), states=dn + [f"d{n}" for n in dn])
-    structure = BlockStructure([Block.real(r, p.name) for p, r in zip(params, reps)])
-    inputs, outputs = dict(inputs), dict(outputs)
-
-    def build(values):
-        Nv = evaluate(values)
-        return mck_to_ss(Nv[:, 2 * ndof:], Nv[:, ndof:2 * ndof], Nv[:, :ndof], inputs, outputs,
-                         dof_names=dof_names)
-
-    return UncertainModel(P, structure, params, build, tuple(reps))
+    return np.array(rowsC), np.array(rowsDw).reshape(-1, nunc), np.array(rowsDu)
