@@ -84,7 +84,7 @@ class Hypothesis:
         One-parameter hypotheses this one reduces to in a limit of its
         parameters (a pedestal of no mass is a softer spring): with several
         effects, the simpler reading replaces it when the data cannot tell
-        them apart (:func:`mutext.diagnose._core._simplify`).
+        them apart (:func:`mutext.diagnose._decision._simplify`).
     crack : callable or None
         Depth ratio -> stiffness change on ``dofs`` (crack hypotheses).
     run : tuple of str
