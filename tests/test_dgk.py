@@ -27,6 +27,9 @@ def two_mass_dgk():
     return res, CL, ab13md_sweep(CL, res.sweep.omega, TWO_MASS_KINDS), buf.getvalue(), calls
 
 
+# slow: the D-G-K run on the two-mass problem (19 CPU-s, shared by three tests); in the default run D-G-K is
+# checked by dgk_iteration's Example (the same problem on a coarse grid: the scales tried) and the failing-try test
+@pytest.mark.slow
 def test_dgk_beats_complex_dk_on_the_loop_as_given(two_mass_dgk):
     """Two-mass problem at 0.041 m: with the parameters' ranges at 0.97 in the K steps, the D-G
     bound of the true loop (AB13MD) is below plain D-K's with the same options (1.0157 against
@@ -43,6 +46,9 @@ def test_dgk_beats_complex_dk_on_the_loop_as_given(two_mass_dgk):
     assert res.mu_upper > 1.003 * res.mu_upper_dg
 
 
+# slow: the D-G-K run on the two-mass problem (19 CPU-s, shared by three tests); in the default run D-G-K is
+# checked by dgk_iteration's Example (the same problem on a coarse grid: the scales tried) and the failing-try test
+@pytest.mark.slow
 def test_dgk_reported_bound_is_the_ab13md_bound(two_mass_dgk):
     """The reported D-G peak is that of AB13MD on the same grid (to 1e-4), not the complex
     value of a flat stretch of the bound (the D-G bound has to be evaluated there too)."""
@@ -62,6 +68,9 @@ def test_dgk_reported_bound_is_the_ab13md_bound(two_mass_dgk):
     assert np.linalg.norm(Delta, 2) == pytest.approx(1 / res.mu_lower, rel=1e-6)
 
 
+# slow: the D-G-K run on the two-mass problem (19 CPU-s, shared by three tests); in the default run D-G-K is
+# checked by dgk_iteration's Example (the same problem on a coarse grid: the scales tried) and the failing-try test
+@pytest.mark.slow
 def test_dgk_prints_each_try_and_notes_the_choice(two_mass_dgk):
     res, _, _, text, calls = two_mass_dgk
     assert "D-G-K try 1/2: the K steps see the real parameters over 1.0000 x their range" in text

@@ -218,6 +218,8 @@ def test_magnitude_fit_of_non_minimum_phase_system_is_its_minimum_phase_factor()
 
 # --- upper envelopes (mutext.frfit.fit_envelope, the spread-shaped weights of mutext.mbi) ---------
 
+# slow (8 CPU-s): fit_envelope in the default run through mbi's spread weight (test_mbi)
+@pytest.mark.slow
 def test_envelope_covers_a_spread_with_three_resonances():
     import control as ct
     # a three-mass rig with m3, c3, k3 each at +-10 %: three resonances of different height, and a

@@ -381,6 +381,8 @@ def test_measured_frf_without_frequency_overlap(tmp_path):
         identify(**args, omega=np.logspace(3, 4, 20), out=None)
 
 
+# slow (6 CPU-s): identify() from a measured FRF file stays in the default run
+@pytest.mark.slow
 def test_demo_from_a_measured_sweep(tmp_path, capsys):
     """`mutext demo three-mass --trial 4 --measured 0.01`: all three hidden parts from a noisy sweep."""
     import json

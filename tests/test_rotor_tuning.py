@@ -108,6 +108,8 @@ def test_model_response_uses_the_channel_of_the_frf(rotor):
 # fits
 # ----------------------------------------------------------------------------
 
+# slow (8 CPU-s): tune() on sweeps in the default run: the crack depth ratio and the thesis hand tuning
+@pytest.mark.slow
 def test_recovers_bearing_stiffness_and_density_with_consistent_uncertainty(rotor):
     k0, rho0 = rotor.parameter("bearing2.k").value, rotor.parameter("rho").value
     truth = {"bearing2.k": 1.3 * k0, "bearing29.k": 1.3 * k0, "rho": 0.97 * rho0}
