@@ -253,6 +253,8 @@ def test_dk_rejects_bad_options(kw, match):
 # two-mass demo (thesis sec. 2.3.2)
 # ----------------------------------------------------------------------------
 
+# slow (5 CPU-s): the demo's D-K run; dk_iteration's Example checks the same problem in the default run
+@pytest.mark.slow
 def test_two_mass_mu_json_keys(capsys):
     assert cli.main(["demo", "two-mass-mu", "--json", "--max-iter", "2"]) == 0
     captured = capsys.readouterr()

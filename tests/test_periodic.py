@@ -115,6 +115,9 @@ def test_time_integration_closed_crack_and_gasch():
     assert np.all(np.abs(td["H"] - hb) / np.abs(hb) < 3e-3)
 
 
+# slow (3 CPU-s): the analyzer's window term; the time integration against harmonic balance stays in the
+# default run
+@pytest.mark.slow
 def test_analyzer_window_term_at_half_multiples_of_the_speed(mayes):
     # where 2 f is a multiple of the speed, the negative-frequency half of the real excitation
     # reaches the correlation: the result depends on the excitation phase

@@ -134,6 +134,8 @@ def test_recovers_bearing_stiffness_and_density_with_consistent_uncertainty(roto
         assert fits[0.002].std[k] / fits[0.01].std[k] == pytest.approx(0.2, rel=0.2)
 
 
+# slow (5 CPU-s): tune() on sweeps stays in the default run with the thesis hand tuning and the unit checks
+@pytest.mark.slow
 def test_recovers_crack_depth_ratio(cracked):
     frfs = rig_frfs(cracked, noise=0.005, seed=3)
     res = tune(cracked, frfs, ["crack15.depth_ratio"], start={"crack15.depth_ratio": 0.2}, max_points=120)
