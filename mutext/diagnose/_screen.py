@@ -25,15 +25,14 @@ class _Receptance:
         D = C + speed * G
         # a rational impedance element (a model extended by model-based identification) is not in
         # M, C, K: its K(jw) joins the dynamic stiffness at its DOF, as in rotor.analysis.frf
-        from ..rotor.lumped_elements import impedances
-        self.impedances = imp = [(el.dofs(model.layout)[0], el) for el in impedances(model)]
+        from ..rotor.lumped_elements import add_impedances
+        self.model = model
         R = np.empty((self.omega.size, n, n), complex)
         chunk = max(1, int(chunk_bytes // (16 * n * n)))
         for k0 in range(0, self.omega.size, chunk):
             w = self.omega[k0:k0 + chunk, None, None]
             Z = K[None] - w * w * M[None] + 1j * w * D[None]
-            for dof, el in imp:
-                Z[:, dof, dof] += el.response(self.omega[k0:k0 + chunk])
+            add_impedances(Z, model, self.omega[k0:k0 + chunk])
             R[k0:k0 + chunk] = np.linalg.inv(Z)
         self.R = R
         self.M, self.K = M, K

@@ -517,17 +517,14 @@ def _frf(model, f, ins, outs, speed, v) -> FRFMatrix:
     B = model.input_matrix(v)[:, [model.input_names.index(q) for q in ins]]
     Cy = model.output_matrix()[[model.output_names.index(q) for q in outs]]
     D = C + speed * G
-    from .lumped_elements import impedances
-    imp = impedances(model)
-    dofs = {el.name: el.dofs(model.layout)[0] for el in imp}
+    from .lumped_elements import add_impedances
     H = np.empty((len(outs), len(ins), f.size), dtype=complex)
     w = 2 * np.pi * f
     chunk = max(1, int(2_000_000 // max(M.size, 1)))     # about 32 MB of complex matrices at a time
     for k0 in range(0, f.size, chunk):
         wk = w[k0:k0 + chunk, None, None]
         Z = K[None] - wk * wk * M[None] + 1j * wk * D[None]       # dynamic stiffness, batched
-        for el in imp:                                            # rational impedances: K(jw) on their DOF
-            Z[:, dofs[el.name], dofs[el.name]] += el.response(w[k0:k0 + chunk])
+        add_impedances(Z, model, w[k0:k0 + chunk])                # rational impedances: K(jw) on their DOF
         X = np.linalg.solve(Z, np.broadcast_to(B, (wk.shape[0],) + B.shape))
         H[:, :, k0:k0 + chunk] = np.moveaxis(Cy[None] @ X, 0, -1)
     return FRFMatrix(f, H, ins, outs, speed, _port_info(model, ins, outs))

@@ -245,3 +245,30 @@ def impedances(model) -> list:
         Empty for a model without.
     """
     return [el for el in getattr(model, "elements", []) if isinstance(el, Impedance)]
+
+
+def add_impedances(Z, model, omega):
+    r"""Add each impedance element's :math:`K(j\omega)` to a batched dynamic stiffness, in place.
+
+    The one place where a rational element (not part of M, C, K) enters
+    :math:`Z(\omega) = K - \omega^2 M + j\omega D`: the model's own FRF, the
+    diagnosis's receptance and its structure-wide hypotheses all go through it.
+
+    Parameters
+    ----------
+    Z : (nfreq, n, n) complex ndarray
+        Dynamic stiffness at the frequencies ``omega``; changed in place.
+    model : Structure
+        The model whose :class:`Impedance` elements are added (none: ``Z`` is unchanged).
+    omega : (nfreq,) array_like
+        Frequencies [rad/s] of ``Z``'s first axis.
+
+    Returns
+    -------
+    ndarray
+        ``Z``.
+    """
+    for el in impedances(model):
+        d = el.dofs(model.layout)[0]
+        Z[:, d, d] += el.response(omega)
+    return Z

@@ -26,6 +26,7 @@ from __future__ import annotations
 import numpy as np
 
 from ...errors import ModelError
+from ...rotor.lumped_elements import add_impedances
 from ...rotor.model_writer import ModelFile
 from ._base import Hypothesis, local_change
 
@@ -77,8 +78,7 @@ def responses(rec, data, hyps: list, thetas: list) -> list:
         idx = data.idx[ks[0]]
         w = rec.omega[idx] * (1 + eps)
         Z = rec.K[None] - (w * w)[:, None, None] * rec.M[None] + 1j * w[:, None, None] * ((1 + a) * rec.D)[None]
-        for dof, el in rec.impedances:      # a rational element of the model: K(jw) at the scaled axis too
-            Z[:, dof, dof] += el.response(w)
+        add_impedances(Z, rec.model, w)     # a rational element of the model: K(jw) at the scaled axis too
         for h, t in zip(hyps, thetas):
             if h.gain is not None or h.glob is not None:
                 continue
