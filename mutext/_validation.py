@@ -349,8 +349,18 @@ def validate_params(constraints: dict, *, error: type = ModelError):
                 if c is not None and not c.is_satisfied_by(value):
                     raise error(_message(where, name, value, c))
 
+        # keyword-only parameters can only arrive by name: then the call's keywords are all there is
+        # to check (no signature binding on every call of a function called in inner loops)
+        keyword_only = all(sig.parameters[n].kind is inspect.Parameter.KEYWORD_ONLY for n in constraints)
+
         @functools.wraps(func)
         def wrapper(*args, **kwargs):
+            if keyword_only:
+                for name, value in kwargs.items():
+                    c = constraints.get(name)
+                    if c is not None and not c.is_satisfied_by(value):
+                        raise error(_message(where, name, value, c))
+                return func(*args, **kwargs)
             try:
                 bound = sig.bind(*args, **kwargs)
             except TypeError:
