@@ -23,7 +23,8 @@ response
 frfit
     Stable rational models of measured frequency responses (vector fitting).
 rig
-    Virtual test rig and FRF files.
+    FRF files (``read_frf``, ``write_frf``, ``read_frfs``) and, in modules of
+    their own, the virtual test rig (``measure``, ``measure_rotor``, ``with_noise``).
 sysid
     Parameters from free-decay records.
 diagnose
