@@ -42,8 +42,10 @@ plant and its regularisation, :func:`controlled_engineering`), ``_impedance``
 (the identifiable band and the mass-damper-spring reading of ``K``,
 :func:`required_impedance`), ``_floor`` (the spread of the true systems,
 :func:`wz_floor`, :func:`spread_weight`), ``_measured`` (a measured FRF as the
-true system, :func:`true_from_frf`), ``_search`` (the :math:`W_z` search) and
-``_identify`` (:func:`identify` and :class:`MBIResult`).
+true system, :func:`true_from_frf`), ``_search`` (the :math:`W_z` search),
+``_identify`` (:func:`identify` and :class:`MBIResult`) and ``_convex`` (the same
+identification as convex worst-case model matching in the Youla parameter of ``K``,
+:func:`identify_convex`, :func:`chebyshev_radius`; [BB]_).
 
 References
 ----------
@@ -51,9 +53,12 @@ References
    mu-synthesis approach*, M.S. thesis, Cleveland State University, ch. 3.
 .. [WPM] Y. Wang, B. Pettinato and E. Maslen, "Model-based identification of
    unmodeled dynamics", 2009 (cited in [M]_).
+.. [BB] S. Boyd and C. Barratt, *Linear Controller Design: Limits of Performance*, Prentice
+   Hall, 1991.
 """
 from __future__ import annotations
 
+from ._convex import ConvexMBIResult, chebyshev_radius, identify_convex, model_matching
 from ._floor import WzFloor, spread_weight, true_spread, wz_floor
 from ._identify import MBIResult, identify
 from ._impedance import (ImpedanceFit, fit_impedance, identifiable_band, impedance_response, relative_error,
@@ -63,4 +68,5 @@ from ._plant import MBIPlant, controlled_engineering, mbi_plant
 from ._search import WzTry
 
 __all__ = ["MBIPlant", "mbi_plant", "ImpedanceFit", "fit_impedance", "WzTry", "MBIResult", "identify",
-           "WzFloor", "wz_floor", "true_spread", "spread_weight", "true_from_frf", "required_impedance"]
+           "WzFloor", "wz_floor", "true_spread", "spread_weight", "true_from_frf", "required_impedance",
+           "identify_convex", "ConvexMBIResult", "chebyshev_radius", "model_matching"]

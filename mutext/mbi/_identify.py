@@ -98,12 +98,19 @@ class MBIResult:
 
 
 def identify(true, engineering, *, excitation: str, measurement: str, control_input: str,
-             control_output: str, Ww: float = 1.0, Wz: float | None = None, tol: float = 0.05,
-             max_tries: int = 8, regularization: float | None = 1e-4, omega=None,
+             control_output: str, Ww: float = 1.0, Wz: float | None = None, tol: float | None = None,
+             max_tries: int | None = None, regularization: float | None = 1e-4, omega=None,
              dk_options: dict | None = None, out=None, time_limit: float | None = None,
              max_fit_residual: float = 0.2, progress: Callable[[str, float], None] | None = None,
-             real: bool = False, branch: bool = False, weight: str = "flat") -> MBIResult:
+             real: bool = False, branch: bool = False, weight: str = "flat", method: str = "dk") -> MBIResult:
     r"""Identify the unmodeled dynamics of ``engineering`` by mu-synthesis (thesis sec. 3.5).
+
+    ``method="convex"`` solves the same problem as a convex program in the Youla parameter of
+    the controller instead (:func:`identify_convex`; Boyd and Barratt, 1991): the smallest
+    :math:`W_z` the controllers of a rational basis reach on samples of the true set, then a
+    D-G certificate.  On trials 1a-5 of the thesis it certifies a smaller :math:`W_z` than the
+    D-K search (``benchmarks/bench_mbi_convex.py``).  ``method="dk"`` (the default) is the
+    search described below.
 
     Runs D-K iteration on the plant of :func:`mbi_plant` and tunes :math:`W_z`
     by the thesis's step-7 rule, automated: :math:`\mu > 1` means the bound is
@@ -126,10 +133,10 @@ def identify(true, engineering, *, excitation: str, measurement: str, control_in
         First value to try (default: 1 % of the peak open-loop error
         :math:`W_w|x_t - x_e|`, or 1.1 times the floor if that is larger; a
         value at or below the floor is raised to it, with a note).
-    tol : float
-        Accepted distance of mu below 1.
-    max_tries : int
-        Largest number of D-K runs.
+    tol : float, optional
+        Accepted distance of mu below 1 (default 0.05; with ``method="convex"``, 0.02).
+    max_tries : int, optional
+        Largest number of D-K runs (default 8; with ``method="convex"``, of certificates: 6).
     omega : array_like, optional
         Frequency grid (rad/s) for the D steps, the identifiable band and the fit.
     dk_options : dict, optional
@@ -174,6 +181,11 @@ def identify(true, engineering, *, excitation: str, measurement: str, control_in
         (10 %) a flat bound holds ``K`` on 4.5-7.1 rad/s only (the spring read
         to +/-85 N/m), the shaped one over 0.5-32 rad/s (+/-5 N/m).  :math:`W_z` is then the bound
         at the widest spread, and the floor is the floor of the shaped bound.
+    method : {"dk", "convex"}
+        ``"dk"``: the :math:`W_z` search by D-K iteration (above).  ``"convex"``:
+        :func:`identify_convex` (needs a stable engineering model; ``Wz``,
+        ``regularization``, ``dk_options``, ``real`` and ``branch`` do not apply and must keep
+        their defaults; ``tol`` and ``max_tries`` are those of its certificate).
 
     Raises
     ------
@@ -205,7 +217,15 @@ def identify(true, engineering, *, excitation: str, measurement: str, control_in
     >>> bool(r.mu_upper <= 1)                           # the error bound W_z is certified
     True
     """
+    if method == "convex":
+        return _identify_convex(true, engineering, excitation, measurement, control_input, control_output, Ww,
+                                Wz, tol, max_tries, regularization, omega, dk_options, out, time_limit,
+                                max_fit_residual, progress, real, branch, weight)
+    if method != "dk":
+        raise ModelError(f"identify: method must be 'dk' or 'convex', got {method!r}")
     t0 = time.perf_counter()
+    tol = 0.05 if tol is None else tol
+    max_tries = 8 if max_tries is None else max_tries
     _check_search_arguments(max_tries, time_limit, tol, real, branch, weight, true)
     say = _logger(out)
     kw = dict(excitation=excitation, measurement=measurement, control_input=control_input,
@@ -214,6 +234,24 @@ def identify(true, engineering, *, excitation: str, measurement: str, control_in
     search = _search_wz(start.plant_at, start.Wz, start.floor, start.omega, _dk_options(out, dk_options), tol,
                         max_tries, time_limit, t0, say, progress, real, branch)
     return _result(search, start, tol, max_tries, time_limit, t0, progress)
+
+
+def _identify_convex(true, engineering, excitation, measurement, control_input, control_output, Ww, Wz, tol,
+                     max_tries, regularization, omega, dk_options, out, time_limit, max_fit_residual, progress,
+                     real, branch, weight):
+    """:func:`identify` with ``method="convex"``: the D-K options refused, the rest passed on."""
+    from ._convex import identify_convex
+    given = [name for name, v, default in (("Wz", Wz, None), ("regularization", regularization, 1e-4),
+                                           ("dk_options", dk_options, None), ("real", real, False),
+                                           ("branch", branch, False)) if v is not default and v != default]
+    if given:
+        raise ModelError(f"identify: {', '.join(given)} belong(s) to method='dk'; method='convex' finds the "
+                         "smallest W_z itself and certifies it on the unregularised plant")
+    return identify_convex(true, engineering, excitation=excitation, measurement=measurement,
+                           control_input=control_input, control_output=control_output, Ww=Ww, omega=omega,
+                           weight=weight, tol=0.02 if tol is None else tol,
+                           max_tries=6 if max_tries is None else max_tries, max_fit_residual=max_fit_residual, time_limit=time_limit, out=out,
+                           progress=progress)
 
 
 @dataclass
