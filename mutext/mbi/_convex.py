@@ -16,7 +16,8 @@ response affine,
 and every stable :math:`Q` is an internally stabilising :math:`K` (and back).  Robust performance,
 :math:`|x_t(\delta, j\omega) - F_\ell(G_e, K)(j\omega)| \le W_z|S(j\omega)|` for every true
 system :math:`\delta` in the box, is then a convex constraint on :math:`Q` (Boyd and Barratt
-[BB]_, ch. 6 and 15): with :math:`Q = \sum_j q_j\phi_j` on a fixed stable rational basis, samples
+[BB]_: the parameterisation of the achievable loops, ch. 7; a finite (Ritz) basis, ch. 15):
+with :math:`Q = \sum_j q_j\phi_j` on a fixed stable rational basis, samples
 :math:`\delta_i` of the box and a frequency grid :math:`\omega_k`,
 
 .. math::
@@ -47,6 +48,7 @@ import numpy as np
 
 from ..errors import ModelError, SolverError
 from ..lti import as_ss, check_finite, freqresp, is_stable, lft_lower, ss
+from ..mu import default_grid
 from ._floor import _true_systems
 from ._identify import MBIResult, _fit_on_identifiable_band, _logger
 from ._plant import MBIPlant, _index, _true_parts, controlled_engineering, mbi_plant
@@ -365,7 +367,7 @@ def _certify(plant_at, K, Wz0: float, lo: float, omega, tol: float, max_tries: i
     """D-G certificates of ``K`` at successive :math:`W_z` (log-log secant toward
     :math:`\\mu = 1 - \\text{tol}/2`, from ``Wz0``, never below ``lo``), each D-G bound that could
     decide judged by branch and bound on the real parameters (``branch``): the tries and their plants."""
-    from ..mu import branch_peak, default_grid, mu_sweep
+    from ..mu import branch_peak, mu_sweep
     from ._search import _next_wz
     tries, plants = [], []
     Wz, hi = Wz0, None
@@ -408,7 +410,8 @@ def identify_convex(true, engineering, *, excitation: str, measurement: str, con
                     control_output: str, Ww: float = 1.0, omega=None, weight: str = "flat",
                     tol: float = 0.01, margin: float = 0.02, max_tries: int = 6, branch: bool = True,
                     reduce_tol: float = 0.01,
-                    per_decade: float = 3.0, final_points: int = 200, max_fit_residual: float = 0.2,
+                    per_decade: float = 3.0, final_points: int = 200, max_refine: int = 3,
+                    max_fit_residual: float = 0.2,
                     time_limit: float | None = None, out=None, progress=None, rng=0) -> ConvexMBIResult:
     r"""Identify the unmodeled dynamics by convex worst-case model matching (Boyd and Barratt [BB91]_).
 
@@ -471,6 +474,10 @@ def identify_convex(true, engineering, *, excitation: str, measurement: str, con
         Damped basis pairs per decade of the grid.
     final_points : int
         Points of the certificate's grid (added to ``omega``, around the loop's poles).
+    max_refine : int
+        Largest number of times the program is solved again with the frequencies added where
+        the controller's error on the certificate's grid exceeds its sampled bound by more than
+        half the ``margin`` (a narrow resonance between the program's frequencies).
     max_fit_residual : float
         For a measured FRF, as in :func:`identify`.
     time_limit : float, optional
@@ -501,7 +508,8 @@ def identify_convex(true, engineering, *, excitation: str, measurement: str, con
     References
     ----------
     .. [BB91] S. Boyd and C. Barratt, *Linear Controller Design: Limits of Performance*,
-       Prentice Hall, 1991 (the Q-parameterisation, ch. 7; convex specifications, ch. 8-9).
+       Prentice Hall, 1991 (the parameterisation of the achievable loops, ch. 7; the Ritz
+       approximation on a finite basis, ch. 15).
 
     Examples
     --------
@@ -522,7 +530,7 @@ def identify_convex(true, engineering, *, excitation: str, measurement: str, con
     from ..uncertain import UncertainModel
     from ._identify import _start
     t0 = time.perf_counter()
-    _check_options(weight, tol, margin, max_tries, reduce_tol, per_decade, final_points, time_limit)
+    _check_options(weight, tol, margin, max_tries, reduce_tol, per_decade, final_points, max_refine, time_limit)
     if not isinstance(branch, (bool, np.bool_)):
         raise ModelError(f"identify_convex: branch must be True or False, got {branch!r}")
     say = _logger(out)
@@ -548,36 +556,65 @@ def identify_convex(true, engineering, *, excitation: str, measurement: str, con
         systems, _, i, o = _true_systems(true, excitation, measurement, "identify_convex", rng)
     else:
         systems, i, o = [_true_parts(true, excitation, measurement)[0]], 0, 0
-    # the program's grid: the search grid and the floor's zoom on the widest spread
-    wp = omega
+    # the program's grid: the search grid, the certificate's span around the systems' poles (a
+    # measured band leaves K free outside it, where the certificate still looks) and the floor's
+    # zoom on the widest spread
+    wp = np.unique(np.concatenate([omega, default_grid(probe.P, n=final_points // 2, decades=1.5)]))
     if np.isfinite(start.floor.omega):
-        wp = np.unique(np.concatenate([omega, start.floor.omega * np.logspace(-0.02, 0.02, 41)]))
-    X = np.array([freqresp(S, wp)[o, i] for S in systems])
-    scale = np.ones(wp.size) if start.shape is None else np.abs(start.shape(wp))
-    Gew, Geu, Gyw, _, Gyu = _engineering_channels(E, ports, wp)
+        wp = np.unique(np.concatenate([wp, start.floor.omega * np.logspace(-0.02, 0.02, 41)]))
 
-    # the lower bound and the program
+    # the lower bound, the program, the controller; the program's grid refined where the
+    # controller's error on the certificate's grid exceeds its sampled bound
     if progress is not None:
         progress("convex MBI: the Chebyshev bound and the model-matching program", 0.1)
+    basis = _normalise_peaks(_basis_ss(_basis_poles(true, E, wp, per_decade)), wp)
+
+    def shape(w):
+        return np.ones(w.size) if start.shape is None else np.abs(start.shape(w))
+
+    def errors(K, w):
+        """The sampled error of ``K`` at each frequency of ``w`` (the largest over the samples)."""
+        F = freqresp(controlled_engineering(probe, K), w)[0, 0]
+        return Ww * np.max(np.abs(np.array([freqresp(S, w)[o, i] for S in systems]) - F[None, :]), axis=0) / shape(w)
+
+    for rnd in range(max_refine + 1):
+        X = np.array([freqresp(S, wp)[o, i] for S in systems])
+        scale = shape(wp)
+        Gew, Geu, Gyw, _, Gyu = _engineering_channels(E, ports, wp)
+        A = (Geu * Gyw)[:, None] * freqresp(basis, wp)[:, 0, :].T
+        tp = time.perf_counter()
+        g, q, npairs = model_matching(X, Gew, A, scale)
+        gamma = float(Ww * g)
+        say(f"sampled optimum {gamma:.4g} ({basis.nstates}-state basis, {len(systems)} true systems, "
+            f"{wp.size} frequencies, {npairs} active constraints, {time.perf_counter() - tp:.2f} s)")
+        Q, K_full = _youla_controller(basis, q, Gyu)
+        K, e_red = (_reduce(probe, K_full, X, wp, scale, Ww, gamma * (1 + reduce_tol), say) if reduce_tol > 0
+                    else (K_full, _sampled_error(probe, K_full, X, wp, scale, Ww)))
+        fine = np.unique(np.concatenate([default_grid(lft_lower(probe.P, K, 1, 1), n=final_points, decades=1.5),
+                                         omega]))
+        ef = errors(K, fine)
+        e_fine = max(e_red, float(ef.max()))
+        if e_fine <= e_red * (1 + margin / 2) or rnd == max_refine:
+            break
+        # the local maxima above the bound, each with a narrow zoom, join the program's grid
+        peaks = [k for k in range(fine.size) if ef[k] > e_red * (1 + margin / 2)
+                 and ef[k] >= ef[max(k - 1, 0)] and ef[k] >= ef[min(k + 1, fine.size - 1)]]
+        say(f"  the controller's error reaches {e_fine:.4g} between the program's frequencies: "
+            f"{len(peaks)} peak(s) added")
+        wp = np.unique(np.concatenate([wp] + [fine[k] * np.logspace(-0.004, 0.004, 5) for k in peaks]))
+    if rnd:
+        notes.append(f"the program's grid was refined {rnd} time(s) at the peaks of the controller's error "
+                     f"between its frequencies ({wp.size} frequencies in the end)")
     radius, _ = chebyshev_radius(X, scale)
     lower = float(Ww * radius.max())
-    basis = _normalise_peaks(_basis_ss(_basis_poles(true, E, omega, per_decade)), wp)
-    A = (Geu * Gyw)[:, None] * freqresp(basis, wp)[:, 0, :].T
-    tp = time.perf_counter()
-    g, q, npairs = model_matching(X, Gew, A, scale)
-    gamma = float(Ww * g)
-    say(f"sampled optimum {gamma:.4g} ({basis.nstates}-state basis, {len(systems)} true systems, "
-        f"{wp.size} frequencies, {npairs} active constraints, {time.perf_counter() - tp:.2f} s); "
-        f"Chebyshev bound {lower:.4g}; floor {start.floor.value:.4g}")
-    Q, K_full = _youla_controller(basis, q, Gyu)
-    K, e_red = (_reduce(probe, K_full, X, wp, scale, Ww, gamma * (1 + reduce_tol), say) if reduce_tol > 0
-                else (K_full, _sampled_error(probe, K_full, X, wp, scale, Ww)))
+    say(f"Chebyshev bound {lower:.4g}; floor {start.floor.value:.4g}; sampled error of K on the certificate's "
+        f"grid {e_fine:.4g}")
     if K is not K_full:
         notes.append(f"K reduced by balanced truncation (static gain kept) from {K_full.nstates} to {K.nstates} "
                      f"states: sampled bound {gamma:.4g} -> {e_red:.4g} (reduce_tol {reduce_tol:g})")
 
     # the certificate
-    base = max(e_red, 1e-12 * float(np.max(np.abs(X))) * Ww, np.finfo(float).tiny)
+    base = max(e_fine, 1e-12 * float(np.max(np.abs(X))) * Ww, np.finfo(float).tiny)
 
     def plant_at(Wz):
         return mbi_plant(true, E, Wz=Wz, **kw, Wz_shape=start.shape)
@@ -594,8 +631,9 @@ def identify_convex(true, engineering, *, excitation: str, measurement: str, con
                  f"{wp.size} frequencies ({basis.nstates}-state basis of Q); Chebyshev bound {lower:.4g} "
                  f"(no controller reaches less on the samples); certified W_z {tries[best].Wz:.4g} at "
                  f"mu <= {tries[best].mu_upper:.4f} ("
-                 + ("branch and bound; D-G bound " + f"{tries[best].mu_dg:.4f}" if tries[best].mu_upper < tries[best].mu_dg
-                    else "D-G") + f", unregularised plant) after {len(tries)} sweep(s)")
+                 + (f"branch and bound; D-G bound {tries[best].mu_dg:.4f}"
+                    if tries[best].mu_upper < tries[best].mu_dg else "D-G")
+                 + f", unregularised plant) after {len(tries)} sweep(s)")
     if start.measured_fit is not None:
         from types import SimpleNamespace
 
@@ -611,7 +649,8 @@ def identify_convex(true, engineering, *, excitation: str, measurement: str, con
                            basis_order=basis.nstates, samples=len(systems))
 
 
-def _check_options(weight, tol, margin, max_tries, reduce_tol, per_decade, final_points, time_limit) -> None:
+def _check_options(weight, tol, margin, max_tries, reduce_tol, per_decade, final_points, max_refine,
+                   time_limit) -> None:
     """The options of :func:`identify_convex`, checked."""
     def number(x):
         return isinstance(x, (int, float, np.integer, np.floating)) and not isinstance(x, (bool, np.bool_)) \
@@ -626,7 +665,8 @@ def _check_options(weight, tol, margin, max_tries, reduce_tol, per_decade, final
         raise ModelError(f"identify_convex: reduce_tol must be a number >= 0, got {reduce_tol!r}")
     if not (number(per_decade) and per_decade > 0):
         raise ModelError(f"identify_convex: per_decade must be positive, got {per_decade!r}")
-    for name, v, least in (("max_tries", max_tries, 1), ("final_points", final_points, 3)):
+    for name, v, least in (("max_tries", max_tries, 1), ("final_points", final_points, 3),
+                           ("max_refine", max_refine, 0)):
         if isinstance(v, (bool, np.bool_)) or not isinstance(v, (int, np.integer)) or v < least:
             raise ModelError(f"identify_convex: {name} must be an integer >= {least}, got {v!r}")
     if time_limit is not None and not (number(time_limit) and time_limit > 0):

@@ -134,7 +134,7 @@ def identify(true, engineering, *, excitation: str, measurement: str, control_in
         :math:`W_w|x_t - x_e|`, or 1.1 times the floor if that is larger; a
         value at or below the floor is raised to it, with a note).
     tol : float, optional
-        Accepted distance of mu below 1 (default 0.05; with ``method="convex"``, 0.02).
+        Accepted distance of mu below 1 (default 0.05; with ``method="convex"``, 0.01).
     max_tries : int, optional
         Largest number of D-K runs (default 8; with ``method="convex"``, of certificates: 6).
     omega : array_like, optional
@@ -249,9 +249,9 @@ def _identify_convex(true, engineering, excitation, measurement, control_input, 
                          "smallest W_z itself and certifies it on the unregularised plant")
     return identify_convex(true, engineering, excitation=excitation, measurement=measurement,
                            control_input=control_input, control_output=control_output, Ww=Ww, omega=omega,
-                           weight=weight, tol=0.02 if tol is None else tol,
-                           max_tries=6 if max_tries is None else max_tries, max_fit_residual=max_fit_residual, time_limit=time_limit, out=out,
-                           progress=progress)
+                           weight=weight, tol=0.01 if tol is None else tol,
+                           max_tries=6 if max_tries is None else max_tries, max_fit_residual=max_fit_residual,
+                           time_limit=time_limit, out=out, progress=progress)
 
 
 @dataclass
