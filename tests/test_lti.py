@@ -205,18 +205,22 @@ def test_freqresp_stiff_closed_loop_matches_direct_solve():
     lam = np.linalg.eigvals(np.asarray(CL.A))
     assert np.abs(lam).max() > 1e6 and np.abs(lam).min() < 1e-5   # really stiff
     w = np.concatenate([[0.0], np.logspace(-8, 9, 60)])
-    # the direct solve itself is right to ~3e-7 here (checked against mpmath below):
+    # the direct solve itself is right to ~6e-7 here (checked against mpmath below):
     # the problem's conditioning, ||A|| ||A^-1|| eps ~ 0.3 at DC, is far worse
     assert _relerr(freqresp(CL, w), _direct(CL, w)) < 2e-6
     # the Hessenberg-after-balancing route this replaced had a relative error of 2e5 at DC
 
 
 def test_freqresp_stiff_closed_loop_matches_mpmath():
+    """The stiff loop within 1e-6 of 50-digit arithmetic (the goal; the direct solve in double
+    precision is itself off by 5.6e-7 here).  DC and 1e-6 rad/s take the LU route (the modal
+    result fails its backward-error check beside the -1e-6 poles), the others the modal one;
+    1.5776e-3 rad/s is the worst of the benchmark's 401 frequencies (1.7e-7)."""
     pytest.importorskip("mpmath")
     CL = _stiff_closed_loop()
-    w = [0.0, 1e-6, 1e-2, 1.0, 1e3, 1e7]
+    w = [0.0, 1e-6, 1.5775930613623613e-3, 1e-2, 1.0, 1e3, 1e7, 1e9]
     G = freqresp(CL, w)
-    ref = _mp_response(CL, w)
+    ref = _mp_response(CL, w, dps=50)
     for k, wk in enumerate(w):
         assert np.linalg.norm(G[:, :, k] - ref[:, :, k]) <= 1e-6 * np.linalg.norm(ref[:, :, k]), wk
 
