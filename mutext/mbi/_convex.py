@@ -41,6 +41,7 @@ References
 from __future__ import annotations
 
 import time
+import warnings
 from dataclasses import dataclass, field
 
 import control as ct
@@ -205,8 +206,6 @@ def _active_set(solve, residual, X, tol: float = 1e-6, add: int = 2, max_rounds:
 
 
 def _solve(prob, what: str):
-    import warnings
-
     import cvxpy as cp
     try:
         with warnings.catch_warnings():      # "optimal_inaccurate" is accepted, and checked by the caller
@@ -349,7 +348,9 @@ def _reduce(probe: MBIPlant, K, X, omega, scale, Ww: float, target: float, say):
     full = _sampled_error(probe, K, X, omega, scale, Ww)
     for order in range(2, K.nstates, 2):
         try:
-            Kr = ct.balred(K, order, method="matchdc")
+            with warnings.catch_warnings():       # an order below K's unstable part is raised to it
+                warnings.simplefilter("ignore")
+                Kr = ct.balred(K, order, method="matchdc")
         except Exception:     # noqa: BLE001 (slycot's reductions raise several kinds) - keep the full K
             continue
         Kr = ss(np.asarray(Kr.A, float), np.asarray(Kr.B, float), np.asarray(Kr.C, float), np.asarray(Kr.D, float))
@@ -533,6 +534,10 @@ def identify_convex(true, engineering, *, excitation: str, measurement: str, con
     _check_options(weight, tol, margin, max_tries, reduce_tol, per_decade, final_points, max_refine, time_limit)
     if not isinstance(branch, (bool, np.bool_)):
         raise ModelError(f"identify_convex: branch must be True or False, got {branch!r}")
+    from ..response import FRF
+    if weight == "spread" and isinstance(true, FRF):
+        raise ModelError("identify_convex: weight='spread' follows the spread of an uncertain true model; a "
+                         "measured FRF has none (use weight='flat')")
     say = _logger(out)
     ports = dict(excitation=excitation, measurement=measurement, control_input=control_input,
                  control_output=control_output)
