@@ -81,7 +81,10 @@ def freqresp(sys, omega) -> np.ndarray:
         todo = _modal_response(A, B, C, omega, G)
     if todo.any():
         try:
-            G[:, todo] = _direct_response(A, B, C, omega[todo])
+            if todo.all():
+                G = _direct_response(A, B, C, omega)
+            else:
+                G[:, todo] = _direct_response(A, B, C, omega[todo])
         except np.linalg.LinAlgError:
             lam = np.linalg.eigvals(A)
             hit = [w for w in omega[todo] if np.min(np.abs(1j * w - lam)) <= 1e-12 * max(1.0, abs(w))]
@@ -134,7 +137,8 @@ def _direct_response(A, B, C, omega) -> np.ndarray:
         w = omega[s:s + chunk]
         M = np.broadcast_to(-A, (w.size, n, n)).astype(complex)
         M[:, idx, idx] += 1j * w[:, None]
-        G[:, s:s + chunk] = np.moveaxis(C[None] @ np.linalg.solve(M, B[None]), 0, 1)
+        X = np.linalg.solve(M, B[None]).transpose(1, 0, 2).reshape(n, -1)      # (n, F*m): C X is one product
+        G[:, s:s + chunk] = (C @ X).reshape(C.shape[0], w.size, B.shape[1])
     return G
 
 
