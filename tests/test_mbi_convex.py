@@ -171,3 +171,18 @@ def test_three_parameter_trials_certified(name):
     assert r.mu_upper <= 1.0
     assert r.gamma <= 1.001 * r.lower
     assert r.Wz <= 1.2 * r.lower
+
+
+def test_polish_stays_within_its_slack_and_moves_toward_the_target():
+    """The second stage keeps the bound within (1 + polish) of the optimum and is closer to the target."""
+    rng = np.random.default_rng(11)
+    nw, m = 30, 4
+    A = rng.normal(size=(nw, m)) + 1j * rng.normal(size=(nw, m))
+    base = A @ np.array([0.5, -0.2, 0.1, 0.3])
+    X = base[None, :] + 0.05 * (rng.normal(size=(5, nw)) + 1j * rng.normal(size=(5, nw)))
+    target = base + 0.01
+    g, q1, _ = model_matching(X, np.zeros(nw), A)
+    g2, q2, _ = model_matching(X, np.zeros(nw), A, polish=0.05, target=target)
+    assert g2 == pytest.approx(g)
+    assert np.max(np.abs(X - (A @ q2)[None, :])) <= g * 1.05 * (1 + 1e-5)
+    assert np.sum(np.abs(target - A @ q2)) <= np.sum(np.abs(target - A @ q1)) * (1 + 1e-6)
