@@ -1,9 +1,11 @@
 """Benchmark: D-K iteration (mutext.dk.dk_iteration) against dkpy.
 
-mutext runs with its defaults (``mutext default``: K-step plant of at most
-``n + 12`` states), with the budget of ``mutext demo two-mass-mu`` (``mutext
-demo``: ``n + 16``) and with that budget plus finer D fits and more patience
-(``mutext tight``: ``fit_tol=5e-4, rel_improvement=1e-3, max_iter=20,
+mutext runs with its defaults (``mutext default``: D fits to 0.05 %, iterating
+while a step gains 0.1 % (patience 2, at most 20 iterations), a K-step plant of
+at most ``n + 32`` states, the best loop's K step redone 0.01 % above the scaled
+plant's optimal level), with the budget of ``mutext demo two-mass-mu``
+(``mutext demo``: ``n + 16``) and with that budget plus the same fits and
+patience (``mutext tight``: ``fit_tol=5e-4, rel_improvement=1e-3, max_iter=20,
 patience=2``); ``mutext big`` (``n + 20``) and ``mutext patient``
 (``fit_tol=2e-4, rel_improvement=1e-4, patience=4, max_order=5``, ``n + 40``)
 on request (``--tools``), as are ``mutext dgk`` and ``mutext dgk-demo``
@@ -77,6 +79,25 @@ tight-refine``, ...): on the distillation column ``--tools "mutext default"
 1.0501 (2.5 s), 1.0282 (5.7 s), **0.9943** (80 steps, 260 s), 1.0492 and
 1.0786 (dkpy reports 1.0339 and 1.0360; 50 s and 30 s), with 18, 18, 18,
 22 and 22 states.
+
+With the defaults of 27 November 2026 (fits to 0.05 %, patience 2, ``n + 32``
+states, the best K step redone 0.01 % above the optimum), ``--problems
+skogestad two-mass-0.041 two-mass-0.035 --tools "mutext default" "dkpy auto"
+"dkpy fixed"`` (one run, 2 cores shared with other work, wall-clock seconds):
+
+=============== ============== ======== ======== ====== =======
+problem         tool           mu       mu (own) s      states
+=============== ============== ======== ======== ====== =======
+skogestad       mutext default 1.0273   1.0273   13.9   18
+skogestad       dkpy auto      1.1689   1.0377   102.8  22
+skogestad       dkpy fixed     1.0360   1.0360   52.8   22
+two-mass-0.041  mutext default 1.0138   1.0138   26.1   32
+two-mass-0.041  dkpy fixed     1.0142   1.0143   106.4  36
+two-mass-0.035  mutext default 1.1402   1.1402   21.2   30
+two-mass-0.035  dkpy fixed     1.1408   1.1408   86.5   36
+=============== ============== ======== ======== ====== =======
+
+dkpy auto's solver panicked on both two-mass problems.
 
 Usage::
 

@@ -12,6 +12,7 @@ from ..lti import as_ss, blas_single_thread, freqresp, lft_lower
 from ..mu import BlockStructure, MuSweep
 from ._dscale import _check_sizes, scaled_plant
 from ._dstep import _d_step, _sweep_upper
+from ..hinf import hinfsyn
 from ._kstep import _k_step, _k_step_lmi_first, _k_step_riccati
 from ._report import _Heartbeat, _print
 from ._sweep import _default_dk_grid, _dg_peak, _final_analysis, near_axis_poles
@@ -118,9 +119,14 @@ class DKResult:
         return self.K.nstates
 
 
+#: default K-step budget above the plant's order (``max_states``): room for order-4 fits of
+#: four scalar blocks, as the thesis's two-mass problem needs to reach its best D scalings
+_DEFAULT_EXTRA_STATES = 32
+
+
 def dk_iteration(P, structure: BlockStructure, nmeas: int, ncon: int, *, omega=None,
-                 max_iter: int = 8, max_order: int = 4, max_states: int | None = None,
-                 fit_tol: float = 0.02, rel_improvement: float = 0.01, patience: int = 1,
+                 max_iter: int = 20, max_order: int = 4, max_states: int | None = None,
+                 fit_tol: float = 5e-4, rel_improvement: float = 1e-3, patience: int = 2,
                  grid_points: int = 80, final_points: int = 200, dg: bool = True,
                  synthesis=None, out=None, progress=None) -> DKResult:
     r"""D-K iteration for robust performance.
@@ -145,7 +151,7 @@ def dk_iteration(P, structure: BlockStructure, nmeas: int, ncon: int, *, omega=N
         Largest D-fit order per block (0-5).
     max_states : int, optional
         Largest number of states of the K-step plant, ``P.nstates`` plus
-        ``(rows + cols) * order`` per block (default ``P.nstates + 12``).  The
+        ``(rows + cols) * order`` per block (default ``P.nstates + 32``).  The
         cost of an LMI K step grows steeply with it; the D step gives the
         states to the blocks whose fits are worst.
     fit_tol : float
@@ -215,8 +221,8 @@ def dk_iteration(P, structure: BlockStructure, nmeas: int, ncon: int, *, omega=N
     coarse grid of 12 frequencies, the real parameters bounded as complex ones
     (``dg=False``; about a second).  The first, H-infinity, controller leaves
     :math:`\mu` at 3.03; the second, with the fitted D scalings, brings it
-    below 1 (the defaults, eight iterations on 80 points and the D-G bound,
-    reach 0.984 with 16 states in about 10 s):
+    below 1 (the defaults, up to twenty iterations on 80 points and the D-G
+    bound, reach 0.979 with 30 states in about 14 s):
 
     >>> from mutext.examples import two_mass_uncertain as tmu
     >>> P = tmu.plant(0.043)
@@ -224,7 +230,7 @@ def dk_iteration(P, structure: BlockStructure, nmeas: int, ncon: int, *, omega=N
     ...                    dg=False)
     >>> round(res.history[0]["mu"], 2), bool(res.mu_upper < 1), bool(res.mu_lower <= res.mu_upper)
     (3.03, True, True)
-    >>> res.controller_order <= P.nstates + 12
+    >>> res.controller_order <= P.nstates + 32
     True
     """
     t0 = time.perf_counter()
@@ -248,7 +254,7 @@ def _arguments(P, structure, nmeas, ncon, omega, max_iter, max_order, max_states
     if not (isinstance(max_iter, (int, np.integer)) and max_iter >= 1):
         raise ModelError(f"max_iter must be a positive integer, got {max_iter!r}")
     if max_states is None:
-        max_states = P.nstates + 12
+        max_states = P.nstates + _DEFAULT_EXTRA_STATES
     if not (isinstance(max_states, (int, np.integer)) and max_states >= P.nstates):
         raise ModelError(f"max_states must be an integer >= the plant order {P.nstates}, got {max_states!r}")
     if not fit_tol > 0:
@@ -324,6 +330,7 @@ class _DKState:
     history: list = field(default_factory=list)
     notes: list = field(default_factory=list)
     best: tuple | None = None
+    best_plant: object = None           # the scaled plant of the best loop's K step
     lowest: float | None = None
     stall: int = 0
 
@@ -433,6 +440,7 @@ def _iteration(steps: _Steps, P, st: _DKState, table: _Table, it, max_order, rel
     # treat the real parameters as complex)
     if st.best is None or mu_dg_pk < st.best[0]:
         st.best = (mu_dg_pk, K, CL, list(st.fits), it)
+        st.best_plant = PD
     st.stall = 0 if progress else st.stall + 1
     # a single block has no scaling to fit: the first K step is the answer
     stop = st.stall >= patience or it == steps.max_iter or len(S) == 1
@@ -464,8 +472,44 @@ def _dk(P, S, nmeas, ncon, grid, max_iter, max_order, budget, fit_tol, rel_impro
     for it in range(1, max_iter + 1):
         if _iteration(steps, P, st, table, it, max_order, rel_improvement, patience, dg, real_scale):
             break
+    _closer_to_optimum(steps, P, st, dg and bool(table.real_blocks))
     return _result(steps, P if as_given is None else as_given, st, final_points, dg, real_scale, out, t0,
                    new_loop=as_given is not None)
+
+
+#: back-off above the scaled plant's optimal level of the best loop's K step, redone at the end
+_FINAL_BACKOFF = 1e-4
+
+
+def _closer_to_optimum(steps: _Steps, P, st: _DKState, dg: bool) -> None:
+    """The best loop's K step redone with the central controller 0.01 % above the scaled plant's
+    optimal level (the iterations build it 0.1 % above, which keeps their path robust); the new
+    loop replaces the best one if it is stable and its peak on the grid (the D-G bound with
+    ``dg``) is lower.  The default synthesis only: a custom one is left as it is."""
+    if steps.synth is not _k_step or st.best_plant is None:
+        return
+    mu0, _, _, fits, it = st.best
+    steps.report(f"K-step of iteration {it} redone {100 * _FINAL_BACKOFF:g} % above the optimal level", 0.9)
+    try:
+        res = hinfsyn(st.best_plant, steps.nmeas, steps.ncon, backoff=_FINAL_BACKOFF, max_backoff=_FINAL_BACKOFF,
+                      method="riccati")
+    except (InfeasibleError, SolverError, IllPosedError, ModelError):
+        return
+    K = as_ss(res.K, "K")
+    CL = lft_lower(P, K, steps.nmeas, steps.ncon)
+    poles = np.linalg.eigvals(np.asarray(CL.A, float)) if CL.nstates else np.zeros(0)
+    if poles.size and poles.real.max() >= 0:
+        return
+    H = np.moveaxis(freqresp(CL, steps.grid), -1, 0)
+    upper, _ = _sweep_upper(H, steps.Sc, st.Xd, progress=lambda f: steps.report(
+        f"K-step of iteration {it} redone: mu-sweep, {100 * f:.0f} % converged", 0.9))
+    mu = float(upper.max())
+    if dg:
+        mu = _dg_peak(H, steps.S, upper)[0]
+    if mu < mu0:
+        st.notes.append(f"iteration {it}'s K step redone {100 * _FINAL_BACKOFF:g} % above the scaled plant's "
+                        f"optimal level (the iterations use 0.1 %): peak on the grid {mu0:.5f} -> {mu:.5f}")
+        st.best = (mu, K, CL, fits, it)
 
 
 def _result(steps: _Steps, P, st: _DKState, final_points, dg, real_scale, out, t0, new_loop: bool) -> DKResult:

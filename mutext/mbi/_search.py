@@ -118,6 +118,13 @@ def _try_progress(progress, k: int, max_tries: int, Wz: float):
     return report
 
 
+#: the D-K settings of each try (before ``dk_options``): coarse fits and no patience, since a
+#: try only has to tell whether mu is below 1 at its W_z, and a K-step plant of at most 12 states
+#: above the MBI plant's (its singular K steps go by the LMIs, whose cost grows steeply with it)
+_TRY_DK = {"fit_tol": 0.02, "rel_improvement": 0.01, "patience": 1}
+_TRY_EXTRA_STATES = 12
+
+
 def _search_wz(plant_at, Wz: float, floor: WzFloor, omega, opts: dict, tol: float, max_tries: int,
                time_limit, t0: float, say, progress, real: bool = False, branch: bool = False) -> _WzSearch:
     r"""D-K runs at successive :math:`W_z` until :math:`1 - \text{tol} \le \mu \le 1` (see :func:`identify`)."""
@@ -140,7 +147,8 @@ def _search_wz(plant_at, Wz: float, floor: WzFloor, omega, opts: dict, tol: floa
         ti = time.perf_counter()
         try:
             synth = dgk_iteration if real and plant.structure.has_real else dk_iteration
-            res = synth(plant.P, plant.structure, 1, 1, omega=omega, **run_opts)
+            res = synth(plant.P, plant.structure, 1, 1, omega=omega,
+                        **{**_TRY_DK, "max_states": plant.P.nstates + _TRY_EXTRA_STATES, **run_opts})
         except (SolverError, InfeasibleError) as exc:
             # the controller construction is numerically erratic on some badly scaled plants: a
             # slightly looser W_z is a differently scaled plant, and the search goes on
