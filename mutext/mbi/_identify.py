@@ -41,8 +41,8 @@ class MBIResult:
         Mass-damper-spring reading of ``K`` on its identifiable band.
     controlled : control.StateSpace
         The engineering model with ``K`` attached.
-    dk : mutext.dk.DKResult
-        The final D-K run.
+    dk : mutext.dk.DKResult or None
+        The final D-K run (None from the convex route, :class:`ConvexMBIResult`).
     seconds : float
     notes : list of str
     floor : WzFloor
