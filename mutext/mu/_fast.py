@@ -534,16 +534,19 @@ def _upper_fast(M, S: BlockStructure, params: _DGParams, x0=None, B0=None, ftol:
     params.want_cluster, params.cluster = cluster is not None, None
     try:
         with np.errstate(over="ignore", invalid="ignore"):
-            _, y, B, nev = _bfgs(fun, x0[free], B0, ftol=ftol, max_eval=max_eval, info=info, cluster=cluster)
+            f, y, B, nev = _bfgs(fun, x0[free], B0, ftol=ftol, max_eval=max_eval, info=info, cluster=cluster)
     finally:
         params.want_cluster, params.cluster = False, None
     x = x0.copy()
     x[free] = y
-    lam, _ = params.value_grad(x, M, beta0, grad=False)
+    # f is log lambda_max evaluated at exactly these coordinates (the descent returns its point
+    # and value together): no second eigenvalue solve
+    lam = math.exp(f) if math.isfinite(f) else params.value_grad(x, M, beta0, grad=False)[0]
     Dl, Dr, G = params.scalings(x, beta0)
     tag = "fast-dg" if params.use_g else "fast-d"
-    return (MuUpper(float(np.sqrt(max(lam, 0.0))), tag, d=_d_from_matrices(S, Dr), Dl=Dl, Dr=Dr, G=G,
-                    iterations=nev), x, B)
+    # one scaling per block, the last fixed to 1 (its coordinate is 0): exp of the log coordinates
+    d = np.exp(x[:params.m]) if params.diag else _d_from_matrices(S, Dr)
+    return (MuUpper(float(np.sqrt(max(lam, 0.0))), tag, d=d, Dl=Dl, Dr=Dr, G=G, iterations=nev), x, B)
 
 
 def _fast_at(M, S: BlockStructure, params: _DGParams, x0=None, B0=None, ftol: float = 1e-10,

@@ -2,6 +2,7 @@ r""":func:`mu_upper`: the upper bound at one matrix, by the LMI, Osborne or fast
 from __future__ import annotations
 
 import numpy as np
+from scipy.linalg.lapack import zheevd as _zheevd
 
 from .._validation import NoneOr, Options, Real, validate_params
 from ..errors import ModelError, SolverError
@@ -42,8 +43,9 @@ def _gevp_diagonal(M, Dl, Dr, G):
     """:func:`_gevp` for diagonal ``Dl``, ``Dr`` (the scalings of full and 1 x 1 blocks) with
     elementwise square roots; None if a scaling is not diagonal (then :func:`_gevp`), inf if
     one is not positive."""
-    dl, dr = np.diag(Dl), np.diag(Dr)
-    if np.count_nonzero(Dl - np.diag(dl)) or np.count_nonzero(Dr - np.diag(dr)) \
+    dl, dr = Dl.diagonal(), Dr.diagonal()
+    # off-diagonal entries (nonzeros beyond the diagonal's) or a complex diagonal: not this form
+    if np.count_nonzero(Dl) != np.count_nonzero(dl) or np.count_nonzero(Dr) != np.count_nonzero(dr) \
             or np.count_nonzero(dl.imag) or np.count_nonzero(dr.imag):
         return None
     dl, dr = dl.real, dr.real
@@ -55,8 +57,8 @@ def _gevp_diagonal(M, Dl, Dr, G):
     if G is not None:
         GA = ((ri[:, None] * G) / lh) @ A
         H = H + 1j * (GA - GA.conj().T)
-    H = 0.5 * (H + H.conj().T)
-    lam = np.linalg.eigvalsh(H)[-1]
+    w, _, info = _zheevd(H, compute_v=0)       # one triangle: H is Hermitian up to rounding
+    lam = w[-1] if info == 0 else np.linalg.eigvalsh(0.5 * (H + H.conj().T))[-1]
     return float(np.sqrt(max(lam, 0.0)))
 
 
