@@ -8,16 +8,17 @@ turns in one process) for the whole grid.  The references:
 
 * ``mpmath``: ``C (jwI - A)^-1 B + D`` by an LU solve in 50-digit arithmetic in
   the system's own coordinates, on a subset of the grid (every k-th frequency:
-  41 of the stiff loop's 401, 10 below 100 states, 2 at 100 states, where one
+  41 of a stiff loop's 401, 10 below 100 states, 2 at 100 states, where one
   frequency takes 16 CPU-s);
 * ``direct``: a dense complex solve per frequency in double precision, in the
   system's own coordinates, on the whole grid (it agrees with mpmath to 1e-12
-  or better on the random and scaled systems, to 5.6e-7 only on the stiff loop).
+  or better on the random and scaled systems, not on the stiff loops).
 
 Methods: ``mutext`` (balancing by powers of two, then from 16 states up the
 modal route with its componentwise backward-error check, done in blocks of
 frequencies as matrix products; a batched complex LU where that check fails and
-below 16 states), ``hess+bal`` (an earlier ``freqresp``: balancing, Hessenberg
+below 16 states; where the output cancels, one step of refinement in extended
+precision), ``hess+bal`` (an earlier ``freqresp``: balancing, Hessenberg
 form once, then batched LU solves), ``hess-solve`` (balancing, Hessenberg form
 once, then the O(n^2) Hessenberg elimination per frequency that TB05AD does,
 vectorised over frequencies in numpy), ``python-control`` and ``direct``.
@@ -26,63 +27,76 @@ Systems: random stable ones of growing order (``ct.rss`` seeded, 2 inputs, 2
 outputs, 1000 frequencies over 1e-3..1e3 rad/s); the same with states rescaled
 by factors drawn in 1e-8..1e8; the near-axis distillation plant of the tests
 closed by slycot's H-infinity controller (poles from -1e-6 to -5.9e6 rad/s,
-matrix balancing spans 1e11; 400 frequencies over 1e-8..1e9 plus DC).
+matrix balancing spans 1e11; 400 frequencies over 1e-8..1e9 plus DC); the
+distillation column closed by dkpy's D-K controller (``dkpy loop``, 28 states,
+poles from -1e-6 to -6.9e6 rad/s, balancing spans 1e17; 400 frequencies over
+1e-9..1e9 plus DC; left out without dkpy).
 
 Measured (2-core machine shared with other work; CPU ms, best of 5):
 
 ===================  ===============  ==========  ==========  ==========  =========
 system               method           err mpmath  err direct  err p-ctrl  time [ms]
 ===================  ===============  ==========  ==========  ==========  =========
-random n=4           mutext              5.0e-16     7.5e-16     1.1e-15       1.41
-random n=4           hess+bal            3.7e-16     1.3e-15     1.1e-15       1.04
-random n=4           hess-solve          5.4e-16     1.1e-15     1.3e-15       0.81
-random n=4           python-control      5.0e-16     1.1e-15     0.0e+00       8.08
-random n=4           direct              5.0e-16     0.0e+00     1.1e-15      15.70
-random n=10          mutext              5.3e-13     0.0e+00     3.9e-12       3.96
-random n=10          hess+bal            2.3e-12     3.6e-12     4.2e-13       4.08
-random n=10          hess-solve          2.3e-12     3.9e-12     6.4e-15       2.69
-random n=10          python-control      2.3e-12     3.9e-12     0.0e+00       9.78
-random n=10          direct              5.3e-13     0.0e+00     3.9e-12      20.21
-random n=30          mutext              8.4e-14     2.0e-13     1.1e-13       6.26
-random n=30          hess+bal            7.0e-14     2.1e-13     9.3e-14      36.13
-random n=30          hess-solve          7.1e-14     2.1e-13     9.3e-14      18.26
-random n=30          python-control      6.3e-14     1.7e-13     0.0e+00      17.59
-random n=30          direct              7.6e-14     0.0e+00     1.7e-13      51.64
-random n=100         mutext              9.1e-13     3.1e-12     2.4e-12      18.12
-random n=100         hess+bal            8.5e-13     3.3e-12     2.2e-12     276.92
-random n=100         hess-solve          8.2e-13     3.2e-12     2.2e-12      99.56
-random n=100         python-control      1.4e-12     5.4e-12     0.0e+00      31.36
-random n=100         direct              5.6e-13     0.0e+00     5.4e-12     201.61
-scaled 1e+-8 n=10    mutext              4.7e-15     1.0e-14     1.9e-10       3.89
-scaled 1e+-8 n=10    hess+bal            1.2e-14     1.7e-14     1.9e-10       3.64
-scaled 1e+-8 n=10    hess-solve          1.2e-14     1.8e-14     1.9e-10       2.17
-scaled 1e+-8 n=10    python-control      1.4e-10     1.9e-10     0.0e+00       9.52
-scaled 1e+-8 n=10    direct              2.4e-15     0.0e+00     1.9e-10      19.24
-scaled 1e+-8 n=30    mutext              2.5e-14     2.6e-13     8.0e+00       4.34
-scaled 1e+-8 n=30    hess+bal            3.3e-14     3.0e-13     8.0e+00      23.53
-scaled 1e+-8 n=30    hess-solve          3.0e-14     2.9e-13     8.0e+00      13.62
-scaled 1e+-8 n=30    python-control      2.0e+00     3.4e+00     0.0e+00      11.65
-scaled 1e+-8 n=30    direct              1.3e-13     0.0e+00     8.0e+00      31.91
-stiff loop n=20      mutext              1.5e-07     5.6e-07     1.0e-04       4.57
-stiff loop n=20      hess+bal            9.6e+05     9.6e+05     9.6e+05       4.70
-stiff loop n=20      hess-solve          9.6e+05     9.6e+05     9.6e+05       3.44
-stiff loop n=20      python-control      1.0e-04     1.0e-04     0.0e+00       4.79
-stiff loop n=20      direct              2.3e-07     0.0e+00     1.0e-04      10.04
+random n=4           mutext              5.0e-16     7.5e-16     1.1e-15       1.15
+random n=4           hess+bal            3.7e-16     1.3e-15     1.1e-15       1.12
+random n=4           hess-solve          5.4e-16     1.1e-15     1.3e-15       0.80
+random n=4           python-control      5.0e-16     1.1e-15     0.0e+00       7.76
+random n=4           direct              5.0e-16     0.0e+00     1.1e-15      15.15
+random n=10          mutext              5.3e-13     0.0e+00     3.9e-12       3.59
+random n=10          hess+bal            2.3e-12     3.6e-12     4.2e-13       4.00
+random n=10          hess-solve          2.3e-12     3.9e-12     6.4e-15       2.16
+random n=10          python-control      2.3e-12     3.9e-12     0.0e+00       8.43
+random n=10          direct              5.3e-13     0.0e+00     3.9e-12      17.79
+random n=30          mutext              8.4e-14     2.0e-13     1.1e-13       4.53
+random n=30          hess+bal            7.0e-14     2.1e-13     9.3e-14      22.02
+random n=30          hess-solve          7.1e-14     2.1e-13     9.3e-14      11.65
+random n=30          python-control      6.3e-14     1.7e-13     0.0e+00      10.57
+random n=30          direct              7.6e-14     0.0e+00     1.7e-13      29.52
+random n=100         mutext              9.1e-13     3.1e-12     2.4e-12      21.35
+random n=100         hess+bal            8.5e-13     3.3e-12     2.2e-12     272.55
+random n=100         hess-solve          8.2e-13     3.2e-12     2.2e-12     105.28
+random n=100         python-control      1.4e-12     5.4e-12     0.0e+00      33.37
+random n=100         direct              5.6e-13     0.0e+00     5.4e-12     203.61
+scaled 1e+-8 n=10    mutext              4.7e-15     1.0e-14     1.9e-10       3.08
+scaled 1e+-8 n=10    hess+bal            1.2e-14     1.7e-14     1.9e-10       3.33
+scaled 1e+-8 n=10    hess-solve          1.2e-14     1.8e-14     1.9e-10       1.99
+scaled 1e+-8 n=10    python-control      1.4e-10     1.9e-10     0.0e+00       8.17
+scaled 1e+-8 n=10    direct              2.4e-15     0.0e+00     1.9e-10      17.13
+scaled 1e+-8 n=30    mutext              2.5e-14     2.6e-13     8.0e+00       4.88
+scaled 1e+-8 n=30    hess+bal            3.3e-14     3.0e-13     8.0e+00      23.31
+scaled 1e+-8 n=30    hess-solve          3.0e-14     2.9e-13     8.0e+00      12.67
+scaled 1e+-8 n=30    python-control      2.0e+00     3.4e+00     0.0e+00      10.54
+scaled 1e+-8 n=30    direct              1.3e-13     0.0e+00     8.0e+00      29.35
+stiff loop n=20      mutext              1.1e-10     5.6e-07     1.0e-04       9.34
+stiff loop n=20      hess+bal            9.6e+05     9.6e+05     9.6e+05       4.62
+stiff loop n=20      hess-solve          9.6e+05     9.6e+05     9.6e+05       3.19
+stiff loop n=20      python-control      1.0e-04     1.0e-04     0.0e+00       4.39
+stiff loop n=20      direct              2.3e-07     0.0e+00     1.0e-04      10.21
+dkpy loop n=28       mutext              2.2e-09     8.9e-02     3.9e-01      16.83
+dkpy loop n=28       hess+bal            6.3e+09     6.7e+09     7.5e+09       7.28
+dkpy loop n=28       hess-solve          6.3e+09     6.7e+09     7.5e+09       5.31
+dkpy loop n=28       python-control      3.3e-01     3.4e-01     0.0e+00       4.64
+dkpy loop n=28       direct              6.5e-02     0.0e+00     3.9e-01      11.41
 ===================  ===============  ==========  ==========  ==========  =========
 
-At 100 states ``mutext`` takes 0.58x python-control's time (18.1 against 31.4
-ms; 44 -> 18 ms from computing the modal route's products and its backward-error
-check in blocks of frequencies as matrix products instead of per-frequency
-batches); below 16 states it solves by LU and stays 2-6x ahead.  On the stiff
-loop it is within 1.5e-7 of mpmath on these 41 frequencies and 1.7e-7 on all
-401 (the goal was 1e-6); the double-precision direct solve is off by up to
-5.6e-7 there, so only mpmath can judge that row.  python-control's errors on the
-scaled n=30 system (2.0) and on the stiff loop (1e-4) come with its Hessenberg
-evaluation; balanced first, the Hessenberg routes (``hess+bal``,
-``hess-solve``) are right on the scaled systems but off by 9.6e5 on the stiff
-loop, where balancing spreads the state scales over 1e11.  ``hess-solve`` in
-numpy (a Python loop over the n elimination steps) is 5.5x slower than the
-modal route at 100 states.
+At 100 states ``mutext`` takes 0.64x python-control's time (21.4 against 33.4
+ms; 44 ms before its modal route's products and backward-error check were done
+in blocks of frequencies as matrix products); below 16 states it solves by LU
+and stays 2-7x ahead.  The two stiff loops are where the others fail: their
+output ``C X + D`` cancels by up to 1e8 (slycot's controller) and 4e10 (dkpy's)
+against ``|C||X|``, so that rounding X to double precision alone costs that
+many digits.  ``mutext`` refines X there with a residual in extended precision
+and sums the output in extended precision: 1.1e-10 and 2.2e-9 against mpmath
+(1.5e-7 and 4.7e-6 without; the goal was 1e-6), at 2-3x the time of the
+unrefined evaluation (9.3 and 16.8 ms; python-control takes 4.4 and 4.6 ms
+and is off by 1e-4 and 0.33).  The double-precision direct solve is off by
+2.3e-7 and 6.5e-2 there, so only mpmath can judge these rows.  python-control's
+error on the scaled n=30 system (2.0) comes with its Hessenberg evaluation;
+balanced first, the Hessenberg routes (``hess+bal``, ``hess-solve``) are right
+on the scaled systems but off by 1e6..1e10 on the stiff loops, where balancing
+spreads the state scales over 1e11..1e17.  ``hess-solve`` in numpy (a Python
+loop over the n elimination steps) is 5x slower than the modal route at 100
+states.
 
 Run: ``.venv/bin/python benchmarks/bench_freqresp.py``.
 """
@@ -196,6 +210,30 @@ def systems():
     P = ss(data["A"], data["B"], data["C"], data["D"])
     K = ct.hinfsyn(P, 2, 2)[0]
     yield "stiff loop n=20", lft_lower(P, K, 2, 2), np.concatenate([[0.0], np.logspace(-8, 9, 400)]), 10
+    loop = dkpy_loop()
+    if loop is not None:
+        yield f"dkpy loop n={loop.nstates}", loop, np.concatenate([[0.0], np.logspace(-9, 9, 400)]), 10
+
+
+def dkpy_loop():
+    """The distillation column (``mutext.examples.distillation``, as ``dkpy.example_skogestad2006_p325``
+    builds it) closed by dkpy's D-K controller (fixed order 4, 3 iterations, slycot's synthesis, 61
+    frequencies over 1e-3..1e3 rad/s, as ``bench_dk.py`` runs it); None without dkpy."""
+    try:
+        import dkpy
+    except ImportError:
+        return None
+    from threadpoolctl import threadpool_limits
+
+    from mutext.examples import distillation
+    P = distillation.plant()
+    it = dkpy.DkIterFixedOrder(controller_synthesis=dkpy.HinfSynSlicot(),
+                               structured_singular_value=dkpy.SsvLmiBisection(n_jobs=1),
+                               d_scale_fit=dkpy.DScaleFitSlicot(), n_iterations=3, fit_order=4)
+    blocks = [dkpy.ComplexFullBlock(1, 1), dkpy.ComplexFullBlock(1, 1), dkpy.ComplexFullBlock(2, 2)]
+    with threadpool_limits(1), np.errstate(all="ignore"):
+        K = it.synthesize(ct.ss(P.A, P.B, P.C, P.D), 2, 2, np.logspace(-3, 3, 61), blocks)[0]
+    return lft_lower(P, K, 2, 2)
 
 
 def main(reps: int = 5):
