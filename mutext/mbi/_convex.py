@@ -110,15 +110,34 @@ def _engineering_channels(E: ct.StateSpace, ports: dict, omega):
 
 
 # --------------------------------------------------------------------------- the basis
-def _basis_poles(true, E, omega, per_decade: float = 3.0, zeta: float = 0.5) -> np.ndarray:
+def _channel_zeros(E: ct.StateSpace, ports: dict) -> np.ndarray:
+    """The finite zeros of :math:`G_{eu}` and :math:`G_{yw}` (empty where they cannot be computed)."""
+    A, B, C, D = (np.asarray(X, float) for X in (E.A, E.B, E.C, E.D))
+    out = []
+    for o, i in ((ports["measurement"], ports["control_input"]), (ports["control_output"], ports["excitation"])):
+        oi, ii = _index(E, o, "output", "engineering model"), _index(E, i, "input", "engineering model")
+        try:
+            out.append(np.asarray(ct.ss(A, B[:, [ii]], C[[oi]], D[[oi]][:, [ii]]).zeros(), complex))
+        except Exception:     # noqa: BLE001 - the basis goes on without them
+            continue
+    return np.concatenate(out) if out else np.zeros(0, complex)
+
+
+def _basis_poles(true, E, omega, per_decade: float = 3.0, zeta: float = 0.5, zeros=()) -> np.ndarray:
     """Poles of the basis of ``Q`` (one of each conjugate pair, upper half plane or real):
-    the true system's nominal poles (the optimal ``Q`` without uncertainty has them), the
-    engineering model's, and well-damped pairs spread over the grid (``per_decade``)."""
+    the true system's nominal poles and the zeros of :math:`G_{eu}G_{yw}` (the exact match
+    :math:`Q = (x_t - G_{ew})/(G_{eu}G_{yw})` has both; a zero in the right half plane mirrored,
+    those far outside the grid left out), the engineering model's poles, and well-damped pairs
+    spread over the grid (``per_decade``)."""
     from ..uncertain import UncertainModel
     nom = true.nominal() if isinstance(true, UncertainModel) else as_ss(true)
     poles = [np.linalg.eigvals(np.asarray(S.A, float)) for S in (nom, E) if S.nstates]
-    poles = np.concatenate(poles) if poles else np.zeros(0, complex)
     lo, hi = float(omega.min()), float(omega.max())
+    z = np.asarray(zeros, complex)
+    z = z[np.isfinite(z) & (np.abs(z) >= lo / 100) & (np.abs(z) <= hi * 100)]
+    z = np.where(z.real < 0, z, -np.conj(z))
+    z = z[z.real < -1e-9 * np.abs(z)]                  # a zero on the axis has no stable image
+    poles = np.concatenate(poles + [z]) if poles or z.size else np.zeros(0, complex)
     n = max(2, int(np.ceil(per_decade * np.log10(hi / lo))) + 1)
     wn = np.logspace(np.log10(lo), np.log10(hi), n)
     spread = wn * (-zeta + 1j * np.sqrt(1 - zeta ** 2))
@@ -619,7 +638,8 @@ def identify_convex(true, engineering, *, excitation: str, measurement: str, con
     # controller's error on the certificate's grid exceeds its sampled bound
     if progress is not None:
         progress("convex MBI: the Chebyshev bound and the model-matching program", 0.1)
-    basis = _normalise_peaks(_basis_ss(_basis_poles(true, E, wp, per_decade)), wp)
+    basis = _normalise_peaks(_basis_ss(_basis_poles(true, E, wp, per_decade, zeros=_channel_zeros(E, ports))),
+                             wp)
 
     def shape(w):
         return np.ones(w.size) if start.shape is None else np.abs(start.shape(w))
