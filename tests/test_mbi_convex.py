@@ -153,6 +153,21 @@ def test_free_free_engineering_model_is_refused():
         identify_convex(**args)
 
 
+def test_identify_chooses_the_convex_route_by_default(trial_1a):
+    """method='auto': the convex route without D-K options (same result as identify_convex), the
+    D-K search with them, and D-K for an engineering model the Youla parameterisation cannot take."""
+    from mutext.mbi._identify import _convex_applies
+    args = tm.mbi_arguments(tm.TRIALS["1a"])
+    r = identify(**args, omega=W)
+    assert isinstance(r, ConvexMBIResult) and r.dk is None
+    assert r.mu_upper <= 1.0 and r.Wz == pytest.approx(trial_1a.Wz, rel=0.01)   # (a finer certificate grid)
+    assert not _convex_applies(args["engineering"], None, 1e-4, {"max_iter": 1}, False, False)
+    assert not _convex_applies(args["engineering"], 4e-4, 1e-4, None, False, False)
+    free = tm.mechanical_model(tm.TRIALS["1a"].engineering.with_(k3=0.0, c1=0.0, c2=0.0, c3=0.0))
+    assert not _convex_applies(free, None, 1e-4, None, False, False)
+    assert _convex_applies(args["engineering"], None, 1e-4, None, False, False)
+
+
 def test_identify_method_switch():
     args = tm.mbi_arguments(tm.TRIALS["1a"])
     with pytest.raises(ModelError, match="method must be"):
