@@ -480,8 +480,10 @@ def identify_convex(true, engineering, *, excitation: str, measurement: str, con
         K = Q(1 + G_{yu}Q)^{-1}.
 
     With :math:`Q = q_0 + \sum_j q_j\phi_j(s)` on a stable rational basis (the poles of the
-    nominal true system and of the engineering model, the optimal :math:`Q` without
-    uncertainty having the former, and well-damped pairs spread over the grid), the true
+    nominal true system and the zeros of :math:`G_{eu}G_{yw}`, which the exact match
+    :math:`Q = (x_t - G_{ew})/(G_{eu}G_{yw})` without uncertainty has, mirrored into the left
+    half plane where needed; the engineering model's poles; well-damped pairs spread over the
+    grid), the true
     systems :math:`x_t(\delta_i)` on a grid of the uncertainty box (as :func:`wz_floor`) and
     the frequency grid :math:`\omega_k`, the smallest bound any controller of the basis reaches
     on the samples is the second-order cone program
