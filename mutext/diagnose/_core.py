@@ -121,7 +121,10 @@ def diagnose(model, frfs, validate=None, *, alpha: float = 0.01, refit: int = 3,
     True
     """
     with blas_single_thread():        # small dense problems: extra BLAS threads only spin on a busy machine
-        return _diagnose(model, frfs, validate, alpha, refit, noise, out_dir, progress, only, mbi)
+        try:
+            return _diagnose(model, frfs, validate, alpha, refit, noise, out_dir, progress, only, mbi)
+        finally:
+            _EXTENDED.clear()
 
 
 @dataclass
@@ -162,6 +165,7 @@ def _diagnose(model, frfs, validate, alpha, refit, noise, out_dir, progress, onl
     before, rows, summary, unmatched = _what_is_wrong(d)
     # 2. the hypotheses, screened, the best refitted on the extended model, the verdict
     hyps, N, rss0, threshold, findings = _screened(d, alpha, refit, only, notes, tell)
+    d.rec.release()
     none, verdict, ambiguous, sensor = _verdict(d, findings, N, rss0, threshold, notes)
     # 3. goodness of fit; further effects while the residual stays above the noise
     effects, quality, first, verdict = _selection(d, verdict, none, hyps, N, threshold, alpha, notes, tell)
@@ -332,8 +336,7 @@ def _at_speed(result, d, effects, text, findings, verdict, err_after, rss0, tell
         best_ti = d.eng
         if text is not None and any(e.hypothesis.gain is None for e in effects):
             try:
-                best_ti = loads_model(text, source=f"{d.path} (extended)",
-                                      base_dir=os.path.dirname(os.path.abspath(d.path)))
+                best_ti = _extended(text, d.path)
             except ModelError:
                 pass
         result.sidebands = _sidebands(best_ti, d.speed, d.chans)
@@ -566,11 +569,16 @@ def _data_sets(rec, allf, chans, vchans):
         for k, (c, kp) in enumerate(zip(cs, keep)):
             pos = np.searchsorted(allf, c.frf.freq_hz[kp])
             bb = rec.input_vector(c.in_spec)
-            Rb = np.einsum("kij,j->ki", rec.R[pos], bb)        # R b at every DOF, shared by all hypotheses
-            cols[k] = (Rb, rec.R[pos, c.out_dof, :])
+            if rec.modal is None:
+                Rb = rec.apply(pos, bb)             # R b at every DOF, shared by all hypotheses
+                cols[k] = (Rb, rec.row(pos, c.out_dof))
+                H0.append(Rb[:, c.out_dof])
+            else:
+                # from the modes: the response alone; the column and the row a hypothesis needs are formed
+                # when first asked for (_Data.columns)
+                H0.append(rec.modal.apply(rec.omega[pos], np.asarray(bb, float), rows=[c.out_dof])[:, 0])
             idx.append(pos)
             meas.append(c.frf.response[kp])
-            H0.append(Rb[:, c.out_dof])
             b.append(bb)
             fs.append(c.frf.freq_hz[kp])
         return _Data(list(cs), idx, meas, H0, b, fs, cols)
@@ -586,7 +594,9 @@ def _data_sets(rec, allf, chans, vchans):
         fit, held = data_for(chans, kept), data_for(chans, out)
         desc = (f"every {HOLDOUT_EVERY}th frequency of the fitted channels, held out of the fit "
                 f"(no validation files given; neighbouring frequencies are not independent data)")
-    return fit, held, data_for(chans, every), desc
+    # with validation files every fitted line is fitted: the fitted set is all of them (its receptance
+    # pieces held once)
+    return fit, held, fit if vchans else data_for(chans, every), desc
 
 
 def _screen_all(hyps, rec, fit, s2, N, rss0, threshold, tell) -> list:
@@ -670,8 +680,40 @@ def _after(verdict, text, path, rec, chans, all_fit, held):
         return (_Evaluator(rec, all_fit, verdict.hypothesis).responses(verdict.value),
                 _Evaluator(rec, held, verdict.hypothesis).responses(verdict.value))
     # the extended model file itself, loaded as a user would load it
-    ext = loads_model(text, source=f"{path} (extended)", base_dir=os.path.dirname(os.path.abspath(path)))
+    ext = _extended(text, path)
+    if getattr(rec, "modal", None) is not None:
+        # a rotor: the extended model's receptance from its own modes, the channels resolved on it
+        # (what model_response gives, without a dense solve at every frequency)
+        w_all = np.unique(np.concatenate([2 * np.pi * np.asarray(c.frf.freq_hz, float) for c in chans]
+                                         + [2 * np.pi * np.asarray(f, float) for f in held.freq_hz]))
+        speeds = {c.speed for c in chans} | {c.speed for c in held.chans}
+        if len(speeds) == 1:
+            rx = _Receptance(ext, None, speeds.pop(), w_all)
+            if rx.modal is not None:
+                fit_ch, _ = _resolve(ext, [c.frf for c in chans], "data")
+                held_ch, _ = _resolve(ext, [c.frf for c in held.chans], "validation")
+
+                def resp(c, f):
+                    pos = np.searchsorted(w_all, 2 * np.pi * np.asarray(f, float))
+                    return rx.modal.row(w_all[pos], c.out_dof) @ rx.input_vector(c.in_spec)
+                return ([resp(c, c.frf.freq_hz) for c in fit_ch],
+                        [resp(c, fs) for c, fs in zip(held_ch, held.freq_hz)])
     return ([model_response(ext, c.frf) for c in chans],
             [model_response(ext, c.frf, freq_hz=fs) for c, fs in zip(held.chans, held.freq_hz)])
+
+
+#: The extended model file of the diagnosis under way, loaded once (its effect is judged, written, and its
+#: modes looked at): ``(text, path) -> model``, cleared when the diagnosis ends.
+_EXTENDED: dict = {}
+
+
+def _extended(text, path):
+    """The extended model ``text`` (next to the model file ``path``), loaded as a user would load it."""
+    key = (text, os.path.abspath(path))
+    if key not in _EXTENDED:
+        _EXTENDED.clear()
+        _EXTENDED[key] = loads_model(text, source=f"{path} (extended)",
+                                     base_dir=os.path.dirname(os.path.abspath(path)))
+    return _EXTENDED[key]
 
 

@@ -372,7 +372,7 @@ def with_impedance(rec, data, dof: int, z_of) -> list:
     for k, idx in enumerate(data.idx):
         Rb, Ro = data.columns(rec, k)
         z = z_of(rec.omega[idx])
-        out.append(data.H0[k] - z * Ro[:, dof] * Rb[:, dof] / (1 + z * rec.R[idx, dof, dof]))
+        out.append(data.H0[k] - z * Ro[:, dof] * Rb[:, dof] / (1 + z * rec.block(idx, [dof], [dof])[:, 0, 0]))
     return out
 
 

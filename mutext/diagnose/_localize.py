@@ -36,7 +36,7 @@ def _pieces(rec, data, s_dof):
     out = []
     for k, (ch, idx) in enumerate(zip(data.chans, data.idx)):
         Rb, Ro = data.columns(rec, k)
-        out.append((Ro[:, s_dof] * Rb[:, s_dof], rec.R[idx, s_dof, s_dof]))
+        out.append((Ro[:, s_dof] * Rb[:, s_dof], rec.block(idx, [s_dof], [s_dof])[:, 0, 0]))
     return out
 
 
@@ -101,7 +101,7 @@ def localize(rec, fit, held, model, s2: float, stations=None):
             Rb, Ro = data.columns(rec, k_)
             ww = rec.omega[idx]
             ze = k + 1j * ww * c - ww * ww * m
-            out.append(data.H0[k_] - ze * Ro[:, d] * Rb[:, d] / (1 + ze * rec.R[idx, d, d]))
+            out.append(data.H0[k_] - ze * Ro[:, d] * Rb[:, d] / (1 + ze * rec.block(idx, [d], [d])[:, 0, 0]))
         return out
 
     def rss_of(Hs, meas):

@@ -61,7 +61,7 @@ class Compound:
                 self.pieces.append(None)
                 continue
             Rb, Ro = data.columns(rec, k)
-            self.pieces.append((Rb[:, U], Ro[:, U], rec.R[np.ix_(idx, U, U)], rec.omega[idx]))
+            self.pieces.append((Rb[:, U], Ro[:, U], rec.block(idx, U, U), rec.omega[idx]))
 
     def _D(self, w, thetas):
         nU = len(self.U)
