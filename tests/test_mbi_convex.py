@@ -201,3 +201,25 @@ def test_polish_stays_within_its_slack_and_moves_toward_the_target():
     assert g2 == pytest.approx(g)
     assert np.max(np.abs(X - (A @ q2)[None, :])) <= g * 1.05 * (1 + 1e-5)
     assert np.sum(np.abs(target - A @ q2)) <= np.sum(np.abs(target - A @ q1)) * (1 + 1e-6)
+
+
+def test_a_measured_frf_has_no_spread_to_shape_by():
+    from mutext.rig import measure
+    tr = tm.TRIALS["1a"]
+    args = tm.mbi_arguments(tr)
+    args["true"] = measure(tm.mechanical_model(tr.true), "f1", "x1", np.arange(0.2, 10.0, 0.05), noise=0.0,
+                           rng=0, input_station=1, output_station=1)
+    with pytest.raises(ModelError, match="measured FRF has none"):
+        identify_convex(**args, weight="spread")
+
+
+# slow (about 50 CPU-s): the shaped bound on trial 5, three solves of the program and branch and bound
+@pytest.mark.slow
+def test_bound_shaped_by_the_spread_on_trial_5():
+    r = identify_convex(**tm.mbi_arguments(tm.TRIALS["5"]), weight="spread")
+    assert r.mu_upper <= 1.0
+    assert r.plant.Wz_shape is not None
+    assert r.Wz >= r.lower >= r.floor.value * (1 - 1e-6)
+    assert r.Wz <= 1.1 * r.lower               # the D-K search stops at 1.39 times its floor here
+    # the shaped bound holds K over the band: the spring read to within the box's spread
+    assert r.fit.dk == pytest.approx(186.0, rel=0.1)
