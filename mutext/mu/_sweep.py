@@ -334,97 +334,139 @@ def mu_sweep(sys, structure: BlockStructure, omega=None, *, method: str = "auto"
 
     from ..lti import freqresp
     H = response(omega)
-    res = {}
+    bounds = _PointBounds(structure, method, real, lower, rng)
+    for k, w in enumerate(omega):
+        bounds(w, H[:, :, k])
+    bounds.forget_warm_start()
+    if refine and omega.size >= 3:
+        _golden_peaks(bounds, response, npeaks, xtol)
+    if bounds.fast:
+        _fast_peaks(bounds.res, bounds.coords, response, structure, bounds.params, certify, bounds.checked)
+    if lower == "peaks":
+        _lower_at_peaks(bounds.res, response, structure, npeaks, rng)
+    return _as_sweep(bounds.res)
 
-    fast = method in ("fast", "auto")
-    checked = method == "auto"
-    if fast:
-        params = _DGParams(structure, real == "dg" and structure.has_real)
-        coords = {}                  # frequency -> coordinates of its fast scalings
-        warm = {"x": None, "B": None, "top": 0.0, "last": 0.0}
 
-    def evaluate(w, Mw):
+class _PointBounds:
+    """The bounds at single frequencies of :func:`mu_sweep`, kept in ``res`` (frequency ->
+    (upper, lower or None)).  With ``method`` "fast" or "auto" the descents are warm-started
+    from the last frequency done (a refinement point from the nearest one), with half the
+    evaluations where the bound was far below the peak so far, a cold start where the warm one
+    did not converge near the peak, and ("auto") every value certified by its scalings, the LMI
+    where they do not reproduce it."""
+
+    def __init__(self, structure: BlockStructure, method: str, real: str, lower: str, rng):
+        self.structure, self.method, self.real, self.lower, self.rng = structure, method, real, lower, rng
+        self.res = {}
+        self.fast = method in ("fast", "auto")
+        self.checked = method == "auto"
+        if self.fast:
+            self.params = _DGParams(structure, real == "dg" and structure.has_real)
+            self.coords = {}                 # frequency -> coordinates of its fast scalings
+            self.warm = {"x": None, "B": None, "top": 0.0, "last": 0.0}
+
+    def forget_warm_start(self) -> None:
+        """The next points (refinements) start from the nearest frequency done, not the last."""
+        if self.fast:
+            self.warm["x"] = self.warm["B"] = None
+
+    def __call__(self, w, Mw) -> float:
+        """Bound(s) at ``w`` from ``Mw = M(jw)``, recorded; returns the upper bound."""
+        structure = self.structure
         if not np.all(np.isfinite(Mw)):
             raise ModelError(f"the frequency response is not finite at omega = {w:.6g} rad/s "
                              "(a pole on the imaginary axis?)")
-        if fast:
-            if coords and warm["x"] is None:
-                # a refinement point: start from the nearest frequency done
-                near = min(coords, key=lambda v: abs(np.log(max(v, 1e-300)) - np.log(max(w, 1e-300))))
-                warm["x"] = coords[near]
-            # half the evaluations where the last value was far below the peak so far: the
-            # bound stays valid, and its last digits there do not matter
-            budget = _GRID_EVALS if warm["last"] >= _LOW_BAND * warm["top"] else _GRID_EVALS // 2
-            up, x, B = _fast_at(Mw, structure, params, warm["x"], warm["B"], ftol=1e-9, max_eval=budget)
-            if up.iterations >= budget and x is not None and up.value >= _COLD_BAND * warm["top"]:
-                # the warm start did not converge (it can lose its way where the infimum
-                # is approached as a real block's d -> 0 and G -> infinity): a cold start
-                # too, where the value may matter for the peak
-                up2, x2, B2 = _fast_at(Mw, structure, params, None, None, ftol=1e-9, max_eval=4 * _GRID_EVALS)
-                if up2.value < up.value:
-                    up, x, B = up2, x2, B2
-            if checked and _certify(Mw, structure, up) is None:
-                # the scalings do not reproduce the value (rounding in badly scaled
-                # scalings): the LMI there, and no warm start from them
-                up, x, B = mu_upper(Mw, structure, method="lmi", real=real), None, None
-            coords[float(w)] = x
-            warm["x"], warm["B"] = x, B
-            warm["top"] = max(warm["top"], up.value)
-            warm["last"] = up.value
-            lo = _both_lower(Mw, structure, up, rng) if lower == "all" else None
-        elif lower == "all":
-            up, lo = _both(Mw, structure, method, real, rng)
+        if self.fast:
+            up = self._fast(w, Mw)
+            lo = _both_lower(Mw, structure, up, self.rng) if self.lower == "all" else None
+        elif self.lower == "all":
+            up, lo = _both(Mw, structure, self.method, self.real, self.rng)
         else:
-            up, lo = mu_upper(Mw, structure, method=method, real=real), None
-        res[float(w)] = (up, lo)
+            up, lo = mu_upper(Mw, structure, method=self.method, real=self.real), None
+        self.res[float(w)] = (up, lo)
         return up.value
 
-    for k, w in enumerate(omega):
-        evaluate(w, H[:, :, k])
-    if fast:
-        warm["x"] = warm["B"] = None
-    if refine and omega.size >= 3:
-        ws = np.array(sorted(res))
-        ups = np.array([res[w][0].value for w in ws])
-        gr = (np.sqrt(5) - 1) / 2
-        for i in sorted(_local_maxima(ups), key=lambda i: -ups[i])[:npeaks]:
-            a = np.log(ws[i - 1] if i > 0 and ws[i - 1] > 0 else ws[i] / 2 if ws[i] > 0 else ws[1] / 2)
-            b = np.log(ws[min(i + 1, len(ws) - 1)])
-            if b <= a:
-                continue
+    def _fast(self, w, Mw) -> MuUpper:
+        structure, params, warm, coords = self.structure, self.params, self.warm, self.coords
+        if coords and warm["x"] is None:
+            # a refinement point: start from the nearest frequency done
+            near = min(coords, key=lambda v: abs(np.log(max(v, 1e-300)) - np.log(max(w, 1e-300))))
+            warm["x"] = coords[near]
+        # half the evaluations where the last value was far below the peak so far: the
+        # bound stays valid, and its last digits there do not matter
+        budget = _GRID_EVALS if warm["last"] >= _LOW_BAND * warm["top"] else _GRID_EVALS // 2
+        up, x, B = _fast_at(Mw, structure, params, warm["x"], warm["B"], ftol=1e-9, max_eval=budget)
+        if up.iterations >= budget and x is not None and up.value >= _COLD_BAND * warm["top"]:
+            # the warm start did not converge (it can lose its way where the infimum
+            # is approached as a real block's d -> 0 and G -> infinity): a cold start
+            # too, where the value may matter for the peak
+            up2, x2, B2 = _fast_at(Mw, structure, params, None, None, ftol=1e-9, max_eval=4 * _GRID_EVALS)
+            if up2.value < up.value:
+                up, x, B = up2, x2, B2
+        if self.checked and _certify(Mw, structure, up) is None:
+            # the scalings do not reproduce the value (rounding in badly scaled
+            # scalings): the LMI there, and no warm start from them
+            up, x, B = mu_upper(Mw, structure, method="lmi", real=self.real), None, None
+        coords[float(w)] = x
+        warm["x"], warm["B"] = x, B
+        warm["top"] = max(warm["top"], up.value)
+        warm["last"] = up.value
+        return up
 
-            def g(lw):
-                w = float(np.exp(lw))
-                if w in res:
-                    return res[w][0].value
-                return evaluate(w, response([w])[:, :, 0])
-            c, d = b - gr * (b - a), a + gr * (b - a)
-            fc, fd = g(c), g(d)
-            for _ in range(100):
-                if b - a <= xtol:
-                    break
-                if fc > fd:
-                    b, d, fd = d, c, fc
-                    c = b - gr * (b - a)
-                    fc = g(c)
-                else:
-                    a, c, fc = c, d, fd
-                    d = a + gr * (b - a)
-                    fd = g(d)
-    if fast:
-        _fast_peaks(res, coords, response, structure, params, certify, checked)
+
+def _golden_peaks(bounds: _PointBounds, response, npeaks: int, xtol: float) -> None:
+    """Golden-section search (in log frequency, to a bracket of ``xtol``) on the ``npeaks``
+    largest local maxima of the upper bound recorded in ``bounds``."""
+    res = bounds.res
     ws = np.array(sorted(res))
     ups = np.array([res[w][0].value for w in ws])
-    if lower == "peaks":
-        for i in sorted(_local_maxima(ups), key=lambda i: -ups[i])[:npeaks]:
-            w = float(ws[i])
-            up = res[w][0]
-            Mw = response([w])[:, :, 0]
-            lo = mu_lower(Mw, structure, rng=rng)
-            if not structure.has_real and up.value - lo.value > 1e-7 * up.value:
-                lo2 = mu_lower(Mw, structure, rng=rng, scalings=(up.Dl, up.Dr))
-                lo = lo2 if lo2.value > lo.value else lo
-            res[w] = (up, lo)
+    gr = (np.sqrt(5) - 1) / 2
+
+    def g(lw):
+        w = float(np.exp(lw))
+        if w in res:
+            return res[w][0].value
+        return bounds(w, response([w])[:, :, 0])
+    for i in sorted(_local_maxima(ups), key=lambda i: -ups[i])[:npeaks]:
+        a = np.log(ws[i - 1] if i > 0 and ws[i - 1] > 0 else ws[i] / 2 if ws[i] > 0 else ws[1] / 2)
+        b = np.log(ws[min(i + 1, len(ws) - 1)])
+        if b <= a:
+            continue
+        c, d = b - gr * (b - a), a + gr * (b - a)
+        fc, fd = g(c), g(d)
+        for _ in range(100):
+            if b - a <= xtol:
+                break
+            if fc > fd:
+                b, d, fd = d, c, fc
+                c = b - gr * (b - a)
+                fc = g(c)
+            else:
+                a, c, fc = c, d, fd
+                d = a + gr * (b - a)
+                fd = g(d)
+
+
+def _lower_at_peaks(res: dict, response, structure: BlockStructure, npeaks: int, rng) -> None:
+    """Lower bounds (:func:`mu_lower`) at the ``npeaks`` largest local maxima of the upper bound,
+    restarted from the upper bound's scalings where a complex structure's bounds do not meet."""
+    ws = np.array(sorted(res))
+    ups = np.array([res[w][0].value for w in ws])
+    for i in sorted(_local_maxima(ups), key=lambda i: -ups[i])[:npeaks]:
+        w = float(ws[i])
+        up = res[w][0]
+        Mw = response([w])[:, :, 0]
+        lo = mu_lower(Mw, structure, rng=rng)
+        if not structure.has_real and up.value - lo.value > 1e-7 * up.value:
+            lo2 = mu_lower(Mw, structure, rng=rng, scalings=(up.Dl, up.Dr))
+            lo = lo2 if lo2.value > lo.value else lo
+        res[w] = (up, lo)
+
+
+def _as_sweep(res: dict) -> MuSweep:
+    """The :class:`MuSweep` of the bounds recorded (frequency -> (upper, lower or None))."""
+    ws = np.array(sorted(res))
+    ups = np.array([res[w][0].value for w in ws])
     lows = np.array([res[w][1].value if res[w][1] is not None else np.nan for w in ws])
     dd = np.array([res[w][0].d for w in ws])
     methods = [res[w][0].method for w in ws]
