@@ -43,7 +43,9 @@ plant and its regularisation, :func:`controlled_engineering`), ``_impedance``
 :func:`required_impedance`), ``_floor`` (the spread of the true systems,
 :func:`wz_floor`, :func:`spread_weight`), ``_measured`` (a measured FRF as the
 true system, :func:`true_from_frf`), ``_search`` (the :math:`W_z` search),
-``_identify`` (:func:`identify` and :class:`MBIResult`) and ``_convex`` (the same
+``_result`` (:class:`MBIResult`, the reading of ``K`` on its identifiable band),
+``_start`` (the true system, grid, floor and first :math:`W_z` of either route),
+``_identify`` (:func:`identify`) and ``_convex`` (the same
 identification as convex worst-case model matching in the Youla parameter of ``K``,
 :func:`identify_convex`, :func:`chebyshev_radius`; [BB]_).
 
@@ -60,7 +62,8 @@ from __future__ import annotations
 
 from ._convex import ConvexMBIResult, chebyshev_radius, identify_convex, model_matching
 from ._floor import WzFloor, spread_weight, true_spread, wz_floor
-from ._identify import MBIResult, identify
+from ._identify import identify
+from ._result import MBIResult
 from ._impedance import (ImpedanceFit, fit_impedance, identifiable_band, impedance_response, relative_error,
                          required_impedance)
 from ._measured import true_from_frf

@@ -51,7 +51,8 @@ from ..errors import ModelError, SolverError
 from ..lti import as_ss, check_finite, freqresp, is_stable, lft_lower, ss
 from ..mu import default_grid
 from ._floor import _true_systems
-from ._identify import MBIResult, _fit_on_identifiable_band, _logger
+from ._result import MBIResult, _fit_on_identifiable_band, _logger
+from ._start import _start
 from ._plant import MBIPlant, _index, _true_parts, controlled_engineering, mbi_plant
 from ._search import WzTry
 
@@ -78,6 +79,9 @@ class ConvexMBIResult(MBIResult):
         Number of states of the basis (of ``Q``).
     samples : int
         Number of true systems in the program.
+    K, Wz, mu_upper, mu_lower, tries, plant, fit, controlled, dk, seconds, omega, notes, floor, measured_fit
+        As in :class:`MBIResult` (``dk`` is None: no D-K run; ``mu_upper`` is the certified D-G
+        bound of the closed loop at ``Wz``, judged by branch and bound where that bound decides).
     """
     gamma: float = float("nan")
     lower: float = float("nan")
@@ -594,7 +598,6 @@ def identify_convex(true, engineering, *, excitation: str, measurement: str, con
     186
     """
     from ..uncertain import UncertainModel
-    from ._identify import _start
     t0 = time.perf_counter()
     _check_options(weight, tol, margin, max_tries, reduce_tol, per_decade, final_points, max_refine, time_limit,
                    polish)

@@ -1,100 +1,20 @@
 r""":func:`identify`: the identification as a whole (a measured FRF or an uncertain model as the
-true system, the first :math:`W_z` above the floor, the search, the reading of ``K``) and its
-result."""
+true system, the first :math:`W_z` above the floor, the search, the reading of ``K``; the
+convex route where it applies)."""
 from __future__ import annotations
 
 import time
 from collections.abc import Callable
-from dataclasses import dataclass, field
-
-import control as ct
 import numpy as np
 
 from ..errors import ModelError
-from ..lti import as_ss, freqresp
+from ..lti import as_ss
 from ..response import FRF
-from ._floor import WzFloor, spread_weight, wz_floor
-from ._impedance import ImpedanceFit, fit_impedance, identifiable_band
-from ._measured import _measured_notes, _true_from_measured
-from ._plant import MBIPlant, controlled_engineering, mbi_plant
-from ._search import _best_try, _first_wz, _open_loop_difference, _search_grid, _search_notes, _search_wz, _WzSearch
-
-
-@dataclass
-class MBIResult:
-    r"""Result of :func:`identify`.
-
-    Attributes
-    ----------
-    K : control.StateSpace
-        The identified dynamics (force per displacement, applied as :math:`-u`):
-        :math:`K \approx D_u`.
-    Wz : float
-        The accepted error bound (output unit).
-    mu_upper, mu_lower : float
-        Certified robust-performance bounds of the final controller at ``Wz``.
-    tries : list of WzTry
-        Every W_z tried, in order.
-    plant : MBIPlant
-        The plant at the accepted ``Wz``.
-    fit : ImpedanceFit
-        Mass-damper-spring reading of ``K`` on its identifiable band.
-    controlled : control.StateSpace
-        The engineering model with ``K`` attached.
-    dk : mutext.dk.DKResult or None
-        The final D-K run (None from the convex route, :class:`ConvexMBIResult`).
-    seconds : float
-    notes : list of str
-    floor : WzFloor
-        The certified lower bound on any achievable ``Wz`` (:func:`wz_floor`).
-    measured_fit : mutext.frfit.RationalFit or None
-        When the true system was a measured FRF: the rational model that stood in
-        for it, with its residual.
-    omega : ndarray
-        The frequency grid (rad/s) of the search.
-    """
-    K: ct.StateSpace
-    Wz: float
-    mu_upper: float
-    mu_lower: float
-    tries: list
-    plant: MBIPlant
-    fit: ImpedanceFit
-    controlled: ct.StateSpace
-    dk: object
-    seconds: float
-    omega: np.ndarray = field(repr=False, default=None)
-    notes: list = field(default_factory=list)
-    floor: WzFloor | None = None
-    measured_fit: object = None
-
-    def bound(self, omega=None) -> np.ndarray:
-        r"""The certified error bound at ``omega`` (default: the search grid): ``Wz``, or
-        :math:`W_z|S(j\omega)|` with a shaped bound (``weight="spread"``).
-
-        Parameters
-        ----------
-        omega : array_like, optional
-            Frequencies in rad/s (default: the search grid ``omega``).
-        """
-        return self.plant.bound(self.omega if omega is None else omega)
-
-    def error(self, true_system, omega=None) -> np.ndarray:
-        """|x_true - x_controlled| (output unit per input unit) of a true system over ``omega``.
-
-        Parameters
-        ----------
-        true_system : control.StateSpace
-            A true system with the ports ``excitation`` and ``measurement``.
-        omega : array_like, optional
-            Frequencies in rad/s (default: the search grid ``omega``).
-        """
-        omega = self.omega if omega is None else np.asarray(omega, float)
-        pr = self.plant.ports
-        T = as_ss(true_system)
-        i = list(T.input_labels).index(pr["excitation"])
-        o = list(T.output_labels).index(pr["measurement"])
-        return np.abs(freqresp(T, omega)[o, i] - freqresp(self.controlled, omega)[0, 0])
+from ._measured import _measured_notes
+from ._plant import controlled_engineering
+from ._result import MBIResult, _fit_on_identifiable_band, _logger
+from ._search import _best_try, _search_notes, _search_wz, _WzSearch
+from ._start import _Start, _start
 
 
 def identify(true, engineering, *, excitation: str, measurement: str, control_input: str,
@@ -278,56 +198,6 @@ def _identify_convex(true, engineering, excitation, measurement, control_input, 
                            time_limit=time_limit, out=out, progress=progress)
 
 
-@dataclass
-class _Start:
-    """Where the W_z search starts: the true system (a measured FRF's stand-in), the keyword
-    arguments of :func:`mbi_plant` but ``Wz``, the grid, the shape of the bound, the floor,
-    the first W_z and the notes so far."""
-    true: object
-    engineering: object
-    kw: dict
-    omega: np.ndarray
-    shape: object
-    floor: WzFloor
-    Wz: float
-    notes: list
-    measured: object = None
-    measured_fit: object = None
-
-    def plant_at(self, Wz: float) -> MBIPlant:
-        """The identification plant with the error bound ``Wz``."""
-        return mbi_plant(self.true, self.engineering, Wz=Wz, **self.kw)
-
-
-def _start(true, engineering, kw: dict, omega, Wz, weight: str, max_fit_residual, say) -> _Start:
-    """The search's grid, shape, floor and first W_z, from the true system (fitted first if measured)."""
-    excitation, measurement, Ww = kw["excitation"], kw["measurement"], kw["Ww"]
-    measured, measured_fit = None, None
-    if isinstance(true, FRF):
-        measured = true
-        true, measured_fit, omega = _true_from_measured(measured, engineering, omega, excitation, measurement,
-                                                        max_fit_residual, say)
-    probe = mbi_plant(true, engineering, Wz=1.0, **kw)
-    omega = _search_grid(probe, omega)
-    diff = _open_loop_difference(probe, omega, excitation, measurement, Ww)
-    shape = None
-    if weight == "spread":
-        shape = spread_weight(true, excitation=excitation, measurement=measurement, omega=omega)
-        say(f"error bound shaped by the spread of the true systems ({shape.order} poles; the cover is at most "
-            f"{np.exp(shape.error):.2f} times the spread)")
-    floor = wz_floor(true, excitation=excitation, measurement=measurement, Ww=Ww, omega=omega, shape=shape)
-    Wz, notes = _first_wz(Wz, diff, floor)
-    if shape is not None:
-        S = np.abs(shape(omega))
-        notes.append(f"error bound shaped by the spread of the true systems: W_z |S(jw)|, |S| from "
-                     f"{S.min():.3g} to {S.max():.3g} on the grid "
-                     f"(a cover of the spread, at most {np.exp(shape.error):.2f} times it)")
-    if floor.value > 0:
-        say(f"W_z floor {floor.value:.4g} (spread of {floor.samples} true systems at {floor.omega:.4g} rad/s)")
-    return _Start(true, engineering, {**kw, "Wz_shape": shape}, omega, shape, floor, Wz, notes, measured,
-                  measured_fit)
-
-
 def _dk_options(out, dk_options) -> dict:
     """The options of each try's D-K run: 4 iterations, the log on ``out``, then ``dk_options`` (checked)."""
     opts = {"max_iter": 4, "out": None if out is None else out}
@@ -378,14 +248,6 @@ def _result(search: _WzSearch, start: _Start, tol: float, max_tries: int, time_l
                      start.floor, start.measured_fit)
 
 
-def _logger(out):
-    """``say(text)``: a line ``[mbi] text`` on ``out`` (nothing for ``None``)."""
-    def say(text):
-        if out is not None:
-            print(f"[mbi] {text}", file=out, flush=True)
-    return say
-
-
 def _check_search_arguments(max_tries, time_limit, tol, real, branch, weight, true) -> None:
     """The options of :func:`identify`'s search, checked (``true`` for ``weight="spread"``)."""
     if isinstance(max_tries, (bool, np.bool_)) or not isinstance(max_tries, (int, np.integer)) or max_tries < 1:
@@ -406,13 +268,3 @@ def _check_search_arguments(max_tries, time_limit, tol, real, branch, weight, tr
     if weight == "spread" and isinstance(true, FRF):
         raise ModelError("identify: weight='spread' follows the spread of an uncertain true model; a measured "
                          "FRF has none (use weight='flat')")
-
-
-def _fit_on_identifiable_band(plant: MBIPlant, K, omega, notes: list) -> ImpedanceFit:
-    """The impedance fit of ``K`` on its identifiable band (the whole grid if that band is too thin)."""
-    sens, band = identifiable_band(plant, K, omega)
-    if band.sum() < 3:
-        notes.append("K has almost no identifiable band (|s K| >= 1 at fewer than 3 frequencies); "
-                     "the fit uses the whole grid")
-        band = np.ones_like(band)
-    return fit_impedance(K, omega[band], weight=sens[band])
