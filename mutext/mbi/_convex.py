@@ -597,19 +597,74 @@ def identify_convex(true, engineering, *, excitation: str, measurement: str, con
     >>> round(r.fit.dk)                                  # the missing spring [N/m]
     186
     """
-    from ..uncertain import UncertainModel
     t0 = time.perf_counter()
     _check_options(weight, tol, margin, max_tries, reduce_tol, per_decade, final_points, max_refine, time_limit,
                    polish)
-    if not isinstance(branch, (bool, np.bool_)):
-        raise ModelError(f"identify_convex: branch must be True or False, got {branch!r}")
-    from ..response import FRF
-    if weight == "spread" and isinstance(true, FRF):
-        raise ModelError("identify_convex: weight='spread' follows the spread of an uncertain true model; a "
-                         "measured FRF has none (use weight='flat')")
+    E = _checked_inputs(true, engineering, weight, branch)
     say = _logger(out)
     ports = dict(excitation=excitation, measurement=measurement, control_input=control_input,
                  control_output=control_output)
+    if progress is not None:
+        progress("convex MBI: samples of the true systems", 0.0)
+    kw = dict(**ports, Ww=Ww, regularization=None)
+    start = _start(true, E, kw, omega, None, weight, max_fit_residual, say)
+    true, omega, notes = start.true, start.omega, list(start.notes)
+    probe = start.plant_at(1.0)
+    systems, nominal, i, o = _sampled_true(true, excitation, measurement, rng)
+    wp = _program_grid(omega, probe, start.floor, final_points)
+    if progress is not None:
+        progress("convex MBI: the Chebyshev bound and the model-matching program", 0.1)
+    prog = _Program(start, E, ports, probe, systems, nominal, i, o, Ww, say)
+    sol = prog.solve(wp, omega, per_decade, polish, reduce_tol, margin, max_refine, final_points)
+    K, gamma = sol["K"], sol["gamma"]
+    if sol["rounds"]:
+        notes.append(f"the program's grid was refined {sol['rounds']} time(s) at the peaks of the controller's "
+                     f"error between its frequencies ({sol['wp'].size} frequencies in the end)")
+    radius, _ = chebyshev_radius(sol["X"], sol["scale"])
+    lower = float(Ww * radius.max())
+    say(f"Chebyshev bound {lower:.4g}; floor {start.floor.value:.4g}; sampled error of K on the certificate's "
+        f"grid {sol['e_fine']:.4g}")
+    if K is not sol["K_full"]:
+        notes.append(f"K reduced by balanced truncation (static gain kept) from {sol['K_full'].nstates} to "
+                     f"{K.nstates} states: sampled bound {gamma:.4g} -> {sol['e_red']:.4g} (reduce_tol "
+                     f"{reduce_tol:g})")
+
+    # the certificate
+    base = max(sol["e_fine"], 1e-12 * float(np.max(np.abs(sol["X"]))) * Ww, np.finfo(float).tiny)
+
+    def plant_at(Wz):
+        return mbi_plant(true, E, Wz=Wz, **kw, Wz_shape=start.shape)
+
+    tries, plants = _certify(plant_at, K, base * (1 + margin), base, omega, tol, max_tries, final_points,
+                             branch, say, progress, t0, time_limit)
+    ok = [k for k, t in enumerate(tries) if t.mu_upper <= 1.0]
+    best = min(ok, key=lambda k: tries[k].Wz) if ok else int(np.argmin([t.mu_upper for t in tries]))
+    plant, t = plants[best], tries[best]
+    notes += _certificate_notes(tries, best, bool(ok), gamma, lower, len(systems), sol["wp"].size,
+                                prog.basis.nstates)
+    if start.measured_fit is not None:
+        from types import SimpleNamespace
+
+        from ._measured import _measured_notes
+        notes += _measured_notes(plant, SimpleNamespace(K=K), start.measured, start.measured_fit)
+    fit = _fit_on_identifiable_band(plant, K, omega, notes)
+    if progress is not None:
+        progress(f"convex MBI done: W_z = {t.Wz:.4g}, mu <= {t.mu_upper:.4f}", 1.0)
+    return ConvexMBIResult(K, t.Wz, t.mu_upper, t.mu_lower, tries, plant, fit, controlled_engineering(plant, K),
+                           None, time.perf_counter() - t0, omega, notes, start.floor, start.measured_fit,
+                           gamma=gamma, lower=lower, radius=Ww * radius[np.isin(sol["wp"], omega)], Q=sol["Q"],
+                           K_full=sol["K_full"], basis_order=prog.basis.nstates, samples=len(systems))
+
+
+def _checked_inputs(true, engineering, weight: str, branch) -> ct.StateSpace:
+    """The engineering model as a state space, checked finite and stable (the Youla
+    parameterisation needs it), with ``branch`` and the bound's shape checked against ``true``."""
+    from ..response import FRF
+    if not isinstance(branch, (bool, np.bool_)):
+        raise ModelError(f"identify_convex: branch must be True or False, got {branch!r}")
+    if weight == "spread" and isinstance(true, FRF):
+        raise ModelError("identify_convex: weight='spread' follows the spread of an uncertain true model; a "
+                         "measured FRF has none (use weight='flat')")
     E = as_ss(engineering, "engineering model")
     check_finite(E, "engineering model")
     if E.nstates and not is_stable(E):
@@ -618,119 +673,104 @@ def identify_convex(true, engineering, *, excitation: str, measurement: str, con
                          f"{lam[np.argmax(lam.real)]:.4g}); the Youla parameterisation Q = K (1 - G_yu K)^-1 "
                          "needs a stable engineering model (a free-free model has poles at s = 0: ground "
                          "it, or use identify(method='dk'))")
-    if progress is not None:
-        progress("convex MBI: samples of the true systems", 0.0)
-    kw = dict(**ports, Ww=Ww, regularization=None)
-    start = _start(true, E, kw, omega, None, weight, max_fit_residual, say)
-    true, omega, notes = start.true, start.omega, list(start.notes)
-    probe = start.plant_at(1.0)
+    return E
 
-    # the sampled true responses
+
+def _sampled_true(true, excitation, measurement, rng):
+    """``(systems, nominal, i, o)``: the true systems on samples of the uncertainty box (one, a
+    fixed true system, otherwise), the nominal one, and the channel's input and output index."""
+    from ..uncertain import UncertainModel
     if isinstance(true, UncertainModel):
         systems, _, i, o = _true_systems(true, excitation, measurement, "identify_convex", rng)
-        nominal = true.nominal()
-    else:
-        systems, i, o = [_true_parts(true, excitation, measurement)[0]], 0, 0
-        nominal = systems[0]
-    # the program's grid: the search grid, the certificate's span around the systems' poles (a
-    # measured band leaves K free outside it, where the certificate still looks) and the floor's
-    # zoom on the widest spread
+        return systems, true.nominal(), i, o
+    systems = [_true_parts(true, excitation, measurement)[0]]
+    return systems, systems[0], 0, 0
+
+
+def _program_grid(omega, probe: MBIPlant, floor, final_points: int) -> np.ndarray:
+    """The program's grid: the search grid, the certificate's span around the systems' poles (a
+    measured band leaves K free outside it, where the certificate still looks) and the floor's
+    zoom on the widest spread."""
     wp = np.unique(np.concatenate([omega, default_grid(probe.P, n=final_points // 2, decades=1.5)]))
-    if np.isfinite(start.floor.omega):
-        wp = np.unique(np.concatenate([wp, start.floor.omega * np.logspace(-0.02, 0.02, 41)]))
+    if np.isfinite(floor.omega):
+        wp = np.unique(np.concatenate([wp, floor.omega * np.logspace(-0.02, 0.02, 41)]))
+    return wp
 
-    # the lower bound, the program, the controller; the program's grid refined where the
-    # controller's error on the certificate's grid exceeds its sampled bound
-    if progress is not None:
-        progress("convex MBI: the Chebyshev bound and the model-matching program", 0.1)
-    basis = _normalise_peaks(_basis_ss(_basis_poles(true, E, wp, per_decade, zeros=_channel_zeros(E, ports))),
-                             wp)
 
-    def shape(w):
-        return np.ones(w.size) if start.shape is None else np.abs(start.shape(w))
+class _Program:
+    """The model-matching program of one identification: the sampled true responses, the basis
+    of Q, and the controller from its optimum (:meth:`solve`)."""
 
-    def errors(K, w):
+    def __init__(self, start, E, ports, probe: MBIPlant, systems, nominal, i, o, Ww, say):
+        self.start, self.E, self.ports, self.probe = start, E, ports, probe
+        self.systems, self.nominal, self.i, self.o, self.Ww, self.say = systems, nominal, i, o, Ww, say
+        self.basis = None
+
+    def shape(self, w):
+        return np.ones(w.size) if self.start.shape is None else np.abs(self.start.shape(w))
+
+    def errors(self, K, w):
         """The sampled error of ``K`` at each frequency of ``w`` (the largest over the samples)."""
-        F = freqresp(controlled_engineering(probe, K), w)[0, 0]
-        return Ww * np.max(np.abs(np.array([freqresp(S, w)[o, i] for S in systems]) - F[None, :]), axis=0) / shape(w)
+        F = freqresp(controlled_engineering(self.probe, K), w)[0, 0]
+        X = np.array([freqresp(S, w)[self.o, self.i] for S in self.systems])
+        return self.Ww * np.max(np.abs(X - F[None, :]), axis=0) / self.shape(w)
 
-    for rnd in range(max_refine + 1):
-        X = np.array([freqresp(S, wp)[o, i] for S in systems])
-        scale = shape(wp)
-        Gew, Geu, Gyw, _, Gyu = _engineering_channels(E, ports, wp)
-        A = (Geu * Gyw)[:, None] * freqresp(basis, wp)[:, 0, :].T
-        tp = time.perf_counter()
-        X0, wts = None, None
-        if polish is not None:
-            # the polish: the controlled response closest to the nominal true one, relative to
-            # the difference the controller has to make there
-            X0 = freqresp(nominal, wp)[o, i]
-            d = np.abs(X0 - Gew)
-            wts = scale / np.maximum(d, 1e-6 * d.max()) if d.max() > 0 else None
-        g, q, npairs = model_matching(X, Gew, A, scale, polish=polish, target=X0, weights=wts)
-        gamma = float(Ww * g)
-        say(f"sampled optimum {gamma:.4g} ({basis.nstates}-state basis, {len(systems)} true systems, "
-            f"{wp.size} frequencies, {npairs} active constraints, {time.perf_counter() - tp:.2f} s)")
-        Q, K_full = _youla_controller(basis, q, Gyu)
-        K, e_red = (_reduce(probe, K_full, X, wp, scale, Ww, gamma * (1 + reduce_tol), say) if reduce_tol > 0
-                    else (K_full, _sampled_error(probe, K_full, X, wp, scale, Ww)))
-        fine = np.unique(np.concatenate([default_grid(lft_lower(probe.P, K, 1, 1), n=final_points, decades=1.5),
-                                         omega]))
-        ef = errors(K, fine)
-        e_fine = max(e_red, float(ef.max()))
-        if e_fine <= e_red * (1 + margin / 2) or rnd == max_refine:
-            break
-        # the local maxima above the bound, each with a narrow zoom, join the program's grid
-        peaks = [k for k in range(fine.size) if ef[k] > e_red * (1 + margin / 2)
-                 and ef[k] >= ef[max(k - 1, 0)] and ef[k] >= ef[min(k + 1, fine.size - 1)]]
-        say(f"  the controller's error reaches {e_fine:.4g} between the program's frequencies: "
-            f"{len(peaks)} peak(s) added")
-        wp = np.unique(np.concatenate([wp] + [fine[k] * np.logspace(-0.004, 0.004, 5) for k in peaks]))
-    if rnd:
-        notes.append(f"the program's grid was refined {rnd} time(s) at the peaks of the controller's error "
-                     f"between its frequencies ({wp.size} frequencies in the end)")
-    radius, _ = chebyshev_radius(X, scale)
-    lower = float(Ww * radius.max())
-    say(f"Chebyshev bound {lower:.4g}; floor {start.floor.value:.4g}; sampled error of K on the certificate's "
-        f"grid {e_fine:.4g}")
-    if K is not K_full:
-        notes.append(f"K reduced by balanced truncation (static gain kept) from {K_full.nstates} to {K.nstates} "
-                     f"states: sampled bound {gamma:.4g} -> {e_red:.4g} (reduce_tol {reduce_tol:g})")
+    def solve(self, wp, omega, per_decade, polish, reduce_tol, margin, max_refine, final_points) -> dict:
+        """The program on ``wp``, solved again with frequencies added where the controller's error
+        on the certificate's grid exceeds its sampled bound by more than half the ``margin``."""
+        E, ports, probe, Ww, say = self.E, self.ports, self.probe, self.Ww, self.say
+        self.basis = basis = _normalise_peaks(
+            _basis_ss(_basis_poles(self.start.true, E, wp, per_decade, zeros=_channel_zeros(E, ports))), wp)
+        for rnd in range(max_refine + 1):
+            X = np.array([freqresp(S, wp)[self.o, self.i] for S in self.systems])
+            scale = self.shape(wp)
+            Gew, Geu, Gyw, _, Gyu = _engineering_channels(E, ports, wp)
+            A = (Geu * Gyw)[:, None] * freqresp(basis, wp)[:, 0, :].T
+            tp = time.perf_counter()
+            X0, wts = None, None
+            if polish is not None:
+                # the polish: the controlled response closest to the nominal true one, relative to
+                # the difference the controller has to make there
+                X0 = freqresp(self.nominal, wp)[self.o, self.i]
+                d = np.abs(X0 - Gew)
+                wts = scale / np.maximum(d, 1e-6 * d.max()) if d.max() > 0 else None
+            g, q, npairs = model_matching(X, Gew, A, scale, polish=polish, target=X0, weights=wts)
+            gamma = float(Ww * g)
+            say(f"sampled optimum {gamma:.4g} ({basis.nstates}-state basis, {len(self.systems)} true systems, "
+                f"{wp.size} frequencies, {npairs} active constraints, {time.perf_counter() - tp:.2f} s)")
+            Q, K_full = _youla_controller(basis, q, Gyu)
+            K, e_red = (_reduce(probe, K_full, X, wp, scale, Ww, gamma * (1 + reduce_tol), say) if reduce_tol > 0
+                        else (K_full, _sampled_error(probe, K_full, X, wp, scale, Ww)))
+            fine = np.unique(np.concatenate([default_grid(lft_lower(probe.P, K, 1, 1), n=final_points,
+                                                          decades=1.5), omega]))
+            ef = self.errors(K, fine)
+            e_fine = max(e_red, float(ef.max()))
+            if e_fine <= e_red * (1 + margin / 2) or rnd == max_refine:
+                break
+            # the local maxima above the bound, each with a narrow zoom, join the program's grid
+            peaks = [k for k in range(fine.size) if ef[k] > e_red * (1 + margin / 2)
+                     and ef[k] >= ef[max(k - 1, 0)] and ef[k] >= ef[min(k + 1, fine.size - 1)]]
+            say(f"  the controller's error reaches {e_fine:.4g} between the program's frequencies: "
+                f"{len(peaks)} peak(s) added")
+            wp = np.unique(np.concatenate([wp] + [fine[k] * np.logspace(-0.004, 0.004, 5) for k in peaks]))
+        return {"K": K, "K_full": K_full, "Q": Q, "gamma": gamma, "X": X, "scale": scale, "wp": wp,
+                "e_red": e_red, "e_fine": e_fine, "rounds": rnd}
 
-    # the certificate
-    base = max(e_fine, 1e-12 * float(np.max(np.abs(X))) * Ww, np.finfo(float).tiny)
 
-    def plant_at(Wz):
-        return mbi_plant(true, E, Wz=Wz, **kw, Wz_shape=start.shape)
-
-    tries, plants = _certify(plant_at, K, base * (1 + margin), base, omega, tol, max_tries, final_points,
-                             branch, say, progress, t0, time_limit)
-    ok = [i for i, t in enumerate(tries) if t.mu_upper <= 1.0]
-    best = min(ok, key=lambda i: tries[i].Wz) if ok else int(np.argmin([t.mu_upper for t in tries]))
-    plant = plants[best]
-    if not ok:
-        notes.append(f"no certificate reached mu <= 1 in {len(tries)} tries; returning the lowest mu "
-                     f"({tries[best].mu_upper:.4f} at W_z = {tries[best].Wz:.4g})")
-    notes.append(f"convex model matching: sampled optimum {gamma:.4g} on {len(systems)} true systems x "
-                 f"{wp.size} frequencies ({basis.nstates}-state basis of Q); Chebyshev bound {lower:.4g} "
-                 f"(no controller reaches less on the samples); certified W_z {tries[best].Wz:.4g} at "
-                 f"mu <= {tries[best].mu_upper:.4f} ("
-                 + (f"branch and bound; D-G bound {tries[best].mu_dg:.4f}"
-                    if tries[best].mu_upper < tries[best].mu_dg else "D-G")
-                 + f", unregularised plant) after {len(tries)} sweep(s)")
-    if start.measured_fit is not None:
-        from types import SimpleNamespace
-
-        from ._measured import _measured_notes
-        notes += _measured_notes(plant, SimpleNamespace(K=K), start.measured, start.measured_fit)
-    fit = _fit_on_identifiable_band(plant, K, omega, notes)
-    if progress is not None:
-        progress(f"convex MBI done: W_z = {tries[best].Wz:.4g}, mu <= {tries[best].mu_upper:.4f}", 1.0)
+def _certificate_notes(tries, best: int, passed: bool, gamma, lower, nsys: int, nfreq: int, order: int) -> list:
+    """The notes on the program and on the certificate of the try kept."""
+    notes = []
     t = tries[best]
-    return ConvexMBIResult(K, t.Wz, t.mu_upper, t.mu_lower, tries, plant, fit, controlled_engineering(plant, K),
-                           None, time.perf_counter() - t0, omega, notes, start.floor, start.measured_fit,
-                           gamma=gamma, lower=lower, radius=Ww * radius[np.isin(wp, omega)], Q=Q, K_full=K_full,
-                           basis_order=basis.nstates, samples=len(systems))
+    if not passed:
+        notes.append(f"no certificate reached mu <= 1 in {len(tries)} tries; returning the lowest mu "
+                     f"({t.mu_upper:.4f} at W_z = {t.Wz:.4g})")
+    notes.append(f"convex model matching: sampled optimum {gamma:.4g} on {nsys} true systems x "
+                 f"{nfreq} frequencies ({order}-state basis of Q); Chebyshev bound {lower:.4g} "
+                 f"(no controller reaches less on the samples); certified W_z {t.Wz:.4g} at "
+                 f"mu <= {t.mu_upper:.4f} ("
+                 + (f"branch and bound; D-G bound {t.mu_dg:.4f}" if t.mu_upper < t.mu_dg else "D-G")
+                 + f", unregularised plant) after {len(tries)} sweep(s)")
+    return notes
 
 
 def _check_options(weight, tol, margin, max_tries, reduce_tol, per_decade, final_points, max_refine,
