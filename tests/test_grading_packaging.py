@@ -200,7 +200,7 @@ def test_wheels_students_get_no_answers_instructors_get_the_grader(tmp_path):
     assert student.name.startswith("mutext-") and instructor.name.startswith("mutext_grader-")
     with zipfile.ZipFile(student) as z:
         files = {n: z.read(n) for n in z.namelist() if not n.endswith("/")}
-    assert "mutext/grading/sandbox.py" in files and "mutext/lti.py" in files
+    assert "mutext/grading/sandbox.py" in files and "mutext/lti/__init__.py" in files
     assert _student_problems(files) == []
     assert not any(n.startswith(("instructor/", "tests/", "exercises/")) for n in files)
     with zipfile.ZipFile(instructor) as z:
