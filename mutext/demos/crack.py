@@ -78,7 +78,7 @@ def solve(depth: float = 0.4, law: str = "mayes", noise: float = 0.001, seed: in
           cutoff_hz: float = 250.0, thesis_tables: bool = False, out=sys.stderr, progress=None) -> dict:
     """Everything the demo reports, as a dict (SI; frequencies in Hz).
 
-    ``out`` gets the log, ``progress(stage, fraction)`` the W_z search's progress
+    ``out`` gets the log, ``progress(stage, fraction)`` the identification's progress
     (:func:`mutext.mbi.identify`).
 
     Parameters
@@ -244,7 +244,7 @@ def run(args) -> int:
         from .._files import output_directory
         output_directory(args.plots, "--plots")     # checked before the work, not after it
     from ..progress import ProgressLine
-    prog = ProgressLine()        # the log and the W_z search's bar, both on stderr
+    prog = ProgressLine()        # the log and the identification's bar, both on stderr
     out = solve(args.depth, args.law, args.noise, args.seed, args.cutoff, args.thesis_tables, out=prog,
                 progress=prog)
     if args.json:
