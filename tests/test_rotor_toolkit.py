@@ -460,3 +460,35 @@ def test_periodic_response_and_orbit_bad_input_is_named():
     o = OVERHUNG
     assert r.Y[0, 0].real == pytest.approx(-o["m"] * 9.80665 * o["L"] ** 3 / (3 * o["EI"]), rel=1e-12)
     assert abs(r.X[0, 0]) < 1e-15 and np.all(np.abs(r.X[1:]) < 1e-15)
+
+
+def test_cli_rotor_whirl(capsys, tmp_path):
+    """``mutext rotor whirl``: the peaks of the forward and backward dFRFs of a two-plane sweep at 3000 rpm
+    against the independently written rotor's damped frequencies and whirl senses (modes 3 and 4, 180-210 Hz)."""
+    import json
+
+    from mutext.cli import main
+    from mutext.rotor import data_path
+    assert main(["rotor", "whirl", data_path("rotor.toml"), "--input", "i12", "--output", "x13", "--speed", "3000",
+                 "--freqs", "170:215:1801", "--json"]) == 0
+    out = json.loads(capsys.readouterr().out)
+    assert out["speed_rpm"] == pytest.approx(3000.0)
+    got = {p["direction"]: p["frequency_hz"] for p in out["peaks"]}
+    assert len(out["peaks"]) == 2 and set(got) == {"forward", "backward"}
+    rot = plain_rotor()
+    lam, X = _plain_modes(rot, 3000 * 2 * np.pi / 60, 4)
+    want = {("forward" if _plain_whirl(rot, X[:, k])[0] > 0.5 else "backward"): lam[k].imag / (2 * np.pi)
+            for k in (2, 3)}
+    assert set(want) == {"forward", "backward"}
+    for s in ("forward", "backward"):
+        # the peak of |H| lies O(zeta^2) below the damped frequency
+        assert got[s] == pytest.approx(want[s], rel=1e-3)
+    assert main(["rotor", "whirl", data_path("rotor.toml"), "--input", "12", "--output", "13",
+                 "--freqs", "20:60:401"]) == 0
+    text = capsys.readouterr().out
+    assert "forward" in text and "backward" in text and "600 rpm" in text
+    assert main(["rotor", "whirl", data_path("rotor.toml"), "--input", "i12", "--output", "x13",
+                 "--freqs", "20:10:5"]) == 2
+    assert "--freqs" in capsys.readouterr().err
+    assert main(["rotor", "whirl", str(tmp_path / "none.toml"), "--input", "1", "--output", "2"]) == 1
+    assert "no such model file" in capsys.readouterr().err

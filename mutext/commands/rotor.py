@@ -1,11 +1,17 @@
-"""``mutext rotor campbell MODEL.toml --speeds 0:3000:31 [--modes N] [--orders 1,2,3] [--plot FILE] [--json]``.
+"""``mutext rotor campbell MODEL.toml --speeds 0:3000:31 [--modes N] [--orders 1,2,3] [--plot FILE] [--json]``
+and ``mutext rotor whirl MODEL.toml --input PORT --output PORT [--speed RPM] [--freqs START:STOP:COUNT] [--json]``.
 
-The Campbell diagram of a rotor model file (:func:`mutext.rotor.campbell`):
+``campbell``: the Campbell diagram of a rotor model file (:func:`mutext.rotor.campbell`):
 the whirl frequencies of the lowest modes against speed, forward or backward,
 their logarithmic decrement, and the critical speeds where the excitation
 lines of the orders (1x unbalance, 2x and 3x a breathing crack) cross them.
 Speeds are given in rpm as ``START:STOP:COUNT`` (evenly spaced, both ends
 included) or as a comma-separated list.
+
+``whirl``: the two-plane sweep the virtual rig would record (excited in x and
+in y at the input's station, measured in x and y at the output's:
+:func:`mutext.rig.measure_rotor` with ``planes="xy"``), its directional FRFs and
+their resonances labelled forward or backward (:func:`mutext.rotor.whirl_peaks`).
 """
 from __future__ import annotations
 
@@ -34,6 +40,93 @@ def add_arguments(p):
                                                           "(Brent's method) instead of interpolating")
     c.add_argument("--plot", metavar="FILE", help="save the diagram as an image (PNG, SVG or PDF by extension)")
     c.add_argument("--json", action="store_true", help="print the whole diagram as one JSON object")
+
+    _add_whirl(sub)
+
+def _add_whirl(sub):
+    w = sub.add_parser("whirl", help="forward and backward whirl peaks of a two-plane sweep (directional FRFs)",
+                       description="Excite the rotor in x and in y at the input's station, measure x and y at the "
+                                   "output's (the virtual rig, no noise), and list the resonances of the forward "
+                                   "and backward directional FRFs.")
+    w.add_argument("model", metavar="MODEL.toml", help="rotor model file (two bending planes)")
+    w.add_argument("--input", required=True, metavar="PORT",
+                   help="excitation: a port of the model (e.g. i12) or a station number (a unit force)")
+    w.add_argument("--output", required=True, metavar="PORT",
+                   help="measurement: a port of the model (e.g. x13) or a station number")
+    w.add_argument("--speed", type=float, default=None, metavar="RPM", help="running speed in rpm "
+                   "(default: the model's speed_rpm)")
+    w.add_argument("--freqs", default="20:225:4101", metavar="START:STOP:COUNT",
+                   help="sweep frequencies in Hz (default 20:225:4101, a 0.05 Hz step)")
+    w.add_argument("--json", action="store_true", help="print the peaks as one JSON object")
+
+
+def _port(text: str):
+    """A port name, or a station number given as digits."""
+    return int(text) if text.isdigit() else text
+
+
+def _freqs(text: str):
+    from ..errors import UsageError
+    parts = text.split(":")
+    try:
+        if len(parts) != 3:
+            raise ValueError
+        a, b, n = float(parts[0]), float(parts[1]), int(parts[2])
+    except ValueError:
+        raise UsageError(f"--freqs {text!r}: expected START:STOP:COUNT in Hz, e.g. 20:225:4101") from None
+    if not (math.isfinite(a) and math.isfinite(b) and 0 <= a < b and n >= 3):
+        raise UsageError(f"--freqs {text!r}: need 0 <= START < STOP and COUNT >= 3")
+    import numpy as np
+    return np.linspace(a, b, n)
+
+
+def run_whirl(args) -> int:
+    """``mutext rotor whirl``: the directional FRFs' resonances with their whirl sense.
+
+    Parameters
+    ----------
+    args : argparse.Namespace
+        The parsed command line.
+
+    Returns
+    -------
+    int
+        The exit status.
+    """
+    import os
+
+    from ..errors import ModelError
+    from ..jsonio import print_json
+    from ..rig import measure_rotor
+    from ..rotor import load_model, whirl_peaks
+    f = _freqs(args.freqs)
+    if args.speed is not None and not (math.isfinite(args.speed) and args.speed >= 0):
+        from ..errors import UsageError
+        raise UsageError(f"--speed {args.speed}: expected a non-negative speed in rpm")
+    if not os.path.isfile(args.model):
+        raise ModelError(f"{args.model}: no such model file")
+    model = load_model(args.model)
+    speed_hz = None if args.speed is None else args.speed / 60.0
+    d = measure_rotor(model, _port(args.input), _port(args.output), f, planes="xy",
+                      speed_hz=speed_hz).directional()
+    peaks = whirl_peaks(d)
+    rpm = 60.0 * d.speed_hz if d.speed_hz is not None else float("nan")
+    if args.json:
+        print_json({"model": model.name, "input": args.input, "output": args.output, "speed_rpm": rpm,
+                    "freq_hz": [float(f[0]), float(f[-1]), int(f.size)],
+                    "peaks": [{"frequency_hz": p.frequency_hz, "direction": p.direction, "index": p.index,
+                               "forward": p.forward, "backward": p.backward} for p in peaks]})
+        return 0
+    print(f"directional FRFs of {model.name}: input {args.input}, output {args.output}, {rpm:g} rpm, "
+          f"{f[0]:g}..{f[-1]:g} Hz ({f.size} frequencies)")
+    if not peaks:
+        print("  no resonance in the band")
+        return 0
+    print(f"\n{'peak [Hz]':>10} {'whirl':>9} {'index':>7} {'|H_pp|':>11} {'|H_bb|':>11}")
+    for p in peaks:
+        print(f"{p.frequency_hz:>10.3f} {p.direction:>9} {p.index:>+7.3f} {p.forward:>11.4g} {p.backward:>11.4g}")
+    print("\nindex (|H_pp| - |H_bb|)/(|H_pp| + |H_bb|): +1 all forward, -1 all backward")
+    return 0
 
 
 def parse_speeds(text: str):
@@ -94,6 +187,8 @@ def run(args) -> int:
     int
         The exit status.
     """
+    if args.action == "whirl":
+        return run_whirl(args)
     import os
 
     from ..errors import ModelError, UsageError
