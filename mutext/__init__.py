@@ -43,7 +43,9 @@ first use (``from mutext import hinfsyn, mu_upper, measure``; the list is
 ``mutext.__all__``).
 
 The modules form layers, each importing only from its own and lower ones
-(checked by ``tests/test_layering.py``): errors, jsonio; lti, response;
+(checked by ``tests/test_layering.py``): errors, jsonio and the solver seam
+(``_solver``: every convex program goes to the conic solver through it, with its
+options for the accuracy asked for); lti, response;
 hinf, mu, frfit; dk, uncertain, rotor; mbi, rig, sysid, diagnose, hide, uff,
 batch, report; examples; demos, plots, grading, commands; cli.
 """

@@ -3,7 +3,7 @@
 Bottom-up (a module may import its own layer and those below; within a layer
 the imports between units must not form a cycle)::
 
-    errors, jsonio, _files, _validation
+    errors, jsonio, _files, _validation, _solver (the one seam to the conic solver)
     lti, response, _mpl
     hinf, mu, frfit
     dk, uncertain, rotor/
@@ -28,7 +28,7 @@ import pytest
 PACKAGE = Path(__file__).resolve().parents[1] / "mutext"
 
 LAYERS = [
-    {"errors", "jsonio", "_files", "_validation"},
+    {"errors", "jsonio", "_files", "_validation", "_solver"},
     {"lti", "response", "_mpl"},
     {"hinf", "mu", "frfit"},
     {"dk", "uncertain", "rotor"},

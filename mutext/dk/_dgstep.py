@@ -3,10 +3,9 @@ peak of the scaled bound that :func:`mutext.dk.refine_controller` takes.
 """
 from __future__ import annotations
 
-import warnings
-
 import numpy as np
 
+from .._solver import solve
 from ..errors import SolverError
 from ..mu import BlockStructure, mu_upper
 from ._sweep import _local_maxima
@@ -156,16 +155,10 @@ def _refine_step(modal, theta, pts, M, U, V, rho, w, band=0.01, gap=0.02, spread
     # where Clarabel's factorisation fails, ten times its default regularisation nearly always
     # does it, and SCS, the last resort, is capped (uncapped it took 37 s for a step Clarabel
     # solves in 0.7 s)
-    clarabel = {"tol_feas": 1e-6, "tol_gap_abs": 1e-6, "tol_gap_rel": 1e-6, "reduced_tol_feas": 1e-3,
-                "reduced_tol_gap_abs": 1e-3, "reduced_tol_gap_rel": 1e-3}
-    for solver, opts in ((cp.CLARABEL, clarabel),
-                         (cp.CLARABEL, {**clarabel, "static_regularization_constant": 1e-7}),
-                         (cp.SCS, {"max_iters": 2500})):
+    for solver, accuracy in (("CLARABEL", "step"), ("CLARABEL", "step-regularised"), ("SCS", "step")):
         try:
-            with warnings.catch_warnings():
-                warnings.simplefilter("ignore")      # "solution may be inaccurate": the step is checked anyway
-                prob.solve(solver=solver, **opts)
-        except (cp.error.SolverError, ValueError, ArithmeticError):
+            solve(prob, "the D-G model step", solver=solver, accuracy=accuracy)
+        except SolverError:
             continue
         if d.value is not None and tau.value is not None:
             return np.asarray(d.value, float), float(tau.value), float(peak)

@@ -8,6 +8,7 @@ from dataclasses import dataclass
 import control as ct
 import numpy as np
 
+from .._solver import solve
 from ..errors import ModelError, SolverError
 from ..lti import ss
 from ._vf import _basis, _realisation, _relocate
@@ -260,10 +261,7 @@ def _phi_residues(x, Phi, rw, poles, order: int):
         c = cp.Variable(order + 1)
         prob = cp.Problem(cp.Minimize(cp.sum_squares((A * cs) @ c - Phi * rw)),
                           [(Bd * cs) @ c >= floor, c[0] * cs[0] >= floor])
-        try:
-            prob.solve(solver="CLARABEL")
-        except cp.SolverError as exc:
-            raise SolverError(f"magnitude fit of order {order}: the convex fit failed ({exc})") from None
+        solve(prob, f"magnitude fit of order {order}: the convex fit")
         if c.value is None:
             raise SolverError(f"magnitude fit of order {order}: the convex fit failed (status {prob.status})")
         coef = np.asarray(c.value, float) * cs

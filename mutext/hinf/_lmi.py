@@ -3,31 +3,17 @@ reconstructed from a point inside them (Scherer, Gahinet and Chilali).
 """
 from __future__ import annotations
 
-import warnings
-
 import cvxpy as cp
 import numpy as np
 import scipy.linalg as sla
 
+from .._solver import solve
 from ..errors import InfeasibleError, SolverError
 from ._plant import _sym, PlantParts
 
 
-_TIGHT = {"max_iter": 400}
-
-
-_LOOSE = {"tol_gap_abs": 1e-6, "tol_gap_rel": 1e-6, "tol_feas": 1e-7, "max_iter": 400}
-
-
 def _solve(prob: cp.Problem, solver: str, what: str, gamma_hint=None, tight: bool = True):
-    opts = (_TIGHT if tight else _LOOSE) if solver.upper() == "CLARABEL" else {}
-    try:
-        with warnings.catch_warnings():
-            warnings.simplefilter("ignore")
-            prob.solve(solver=solver, **opts)
-    except cp.error.SolverError as exc:
-        raise SolverError(f"{what}: solver {solver} failed ({exc})") from None
-    status = prob.status
+    status = solve(prob, what, solver=solver, accuracy="tight" if tight else "loose")
     if status in (cp.INFEASIBLE, cp.INFEASIBLE_INACCURATE):
         at = f" at gamma={gamma_hint:.6g}" if gamma_hint is not None else ""
         raise InfeasibleError(f"{what}: LMI infeasible{at} (solver status '{status}')")

@@ -47,6 +47,7 @@ from dataclasses import dataclass, field
 import control as ct
 import numpy as np
 
+from .._solver import solve as _solve_program
 from ..errors import ModelError, SolverError
 from ..lti import as_ss, check_finite, freqresp, is_stable, lft_lower, ss
 from ..mu import default_grid
@@ -230,14 +231,8 @@ def _active_set(solve, residual, X, tol: float = 1e-6, add: int = 2, max_rounds:
 
 
 def _solve(prob, what: str):
-    import cvxpy as cp
-    try:
-        with warnings.catch_warnings():      # "optimal_inaccurate" is accepted, and checked by the caller
-            warnings.simplefilter("ignore", UserWarning)
-            prob.solve(solver=cp.CLARABEL)
-    except cp.error.SolverError as exc:
-        raise SolverError(f"{what}: the solver failed ({exc})") from exc
-    if prob.status not in ("optimal", "optimal_inaccurate"):
+    # "optimal_inaccurate" is accepted, and checked by the caller
+    if _solve_program(prob, what) not in ("optimal", "optimal_inaccurate"):
         raise SolverError(f"{what}: the program ended {prob.status}")
 
 

@@ -8,6 +8,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from .._solver import solve
 from ..errors import SolverError
 from ._certificate import MuUpper, _d_from_matrices, _diag_result, _gevp
 from ._structure import BlockStructure
@@ -120,17 +121,13 @@ class _LMIProblem:
 
     def solve(self, beta):
         """(t, xd, xg) at level beta, or the reason the solver gave no answer (a str)."""
-        import warnings
-
         import cvxpy as cp
         for P, H, (_, Dr) in zip(self.Hd, self.MDM, self.dpairs):
             P.value = _embed(H - beta ** 2 * Dr)
         try:
-            with warnings.catch_warnings():
-                warnings.simplefilter("ignore")
-                self.prob.solve(solver="CLARABEL")
-        except (cp.SolverError, ValueError, ArithmeticError) as exc:
-            return f"{type(exc).__name__}: {exc}"
+            solve(self.prob, f"the D-G LMI at level {beta:.6g}")
+        except SolverError as exc:
+            return f"SolverError: {exc}"
         if self.prob.status not in (cp.OPTIMAL, cp.OPTIMAL_INACCURATE) or self.t.value is None:
             return f"status {self.prob.status}"
         xd = np.asarray(self.xd.value, float)
