@@ -128,7 +128,7 @@ def test_the_refined_mesh_keeps_the_rotor(tmp_path):
 
 @pytest.mark.slow
 def test_a_crack_is_found_on_the_59_station_rotor(tmp_path):
-    # about a minute and a half of CPU (benchmarks/bench_diagnose_scaling.py times it)
+    # about a minute of CPU (benchmarks/bench_diagnose_scaling.py times the diagnosis)
     from bench_diagnose_scaling import refined_rotor
 
     from mutext.diagnose import diagnose

@@ -67,9 +67,12 @@ Every structural hypothesis changes the dynamic stiffness
 :math:`D = S`, a damper :math:`j\omega S`, a mass :math:`-\omega^2 S`, with
 :math:`S` the element's pattern, e.g. :math:`e_ie_i^T` to ground or
 :math:`(e_i-e_j)(e_i-e_j)^T` between two masses).  With the receptance of the
-engineering model :math:`R = Z^{-1}` (one inverse per frequency, shared by all
-hypotheses) the response of the changed model is exact for any size
-(Woodbury identity):
+engineering model :math:`R = Z^{-1}` (shared by all hypotheses: a lumped
+chain's one inverse per frequency; a rotor's from one eigen-decomposition of its
+state space, :math:`R(\omega) = X\,\mathrm{diag}(1/(j\omega - \lambda))\,Y`, of which only
+the pieces below are formed, so that time and memory grow with the number of
+stations, not its square at every frequency) the response of the changed model
+is exact for any size (Woodbury identity):
 
 .. math::
     H_c(\theta) = H_c(0) - \theta\, R_{oU}\, D\,u,\qquad
