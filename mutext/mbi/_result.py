@@ -8,6 +8,8 @@ from dataclasses import dataclass, field
 import control as ct
 import numpy as np
 
+from ..lti import as_ss, freqresp
+from ._floor import WzFloor
 from ._impedance import ImpedanceFit, fit_impedance, identifiable_band
 from ._plant import MBIPlant
 
