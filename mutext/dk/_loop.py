@@ -408,11 +408,11 @@ def _iteration(steps: _Steps, P, st: _DKState, table: _Table, it, max_order, rel
         return True
     K = as_ss(res.K, "K")
     CL = lft_lower(P, K, nmeas, ncon)
-    poles = np.linalg.eigvals(np.asarray(CL.A, float)) if CL.nstates else np.zeros(0)
-    if poles.size and poles.real.max() >= 0:
+    max_re = _max_pole_real(CL)
+    if max_re >= 0:
         # D-hat is stable and minimum phase, so K stabilises P iff it stabilises D P D^-1
         exc = SolverError(f"iteration {it}: the K-step controller does not stabilise the plant "
-                          f"(closed-loop pole with real part {poles.real.max():.3g})")
+                          f"(closed-loop pole with real part {max_re:.3g})")
         if st.best is None:
             raise exc
         st.notes.append(str(exc))
@@ -477,6 +477,13 @@ def _dk(P, S, nmeas, ncon, grid, max_iter, max_order, budget, fit_tol, rel_impro
                    new_loop=as_given is not None)
 
 
+def _max_pole_real(CL) -> float:
+    """The largest real part of the closed loop's poles (-inf without states)."""
+    if not CL.nstates:
+        return float("-inf")
+    return float(np.linalg.eigvals(np.asarray(CL.A, float)).real.max())
+
+
 #: back-off above the scaled plant's optimal level of the best loop's K step, redone at the end
 _FINAL_BACKOFF = 1e-4
 
@@ -497,8 +504,7 @@ def _closer_to_optimum(steps: _Steps, P, st: _DKState, dg: bool) -> None:
         return
     K = as_ss(res.K, "K")
     CL = lft_lower(P, K, steps.nmeas, steps.ncon)
-    poles = np.linalg.eigvals(np.asarray(CL.A, float)) if CL.nstates else np.zeros(0)
-    if poles.size and poles.real.max() >= 0:
+    if _max_pole_real(CL) >= 0:
         return
     H = np.moveaxis(freqresp(CL, steps.grid), -1, 0)
     upper, _ = _sweep_upper(H, steps.Sc, st.Xd, progress=lambda f: steps.report(
@@ -520,8 +526,7 @@ def _result(steps: _Steps, P, st: _DKState, final_points, dg, real_scale, out, t
     if new_loop:
         CL = lft_lower(P, K, steps.nmeas, steps.ncon)
     near = near_axis_poles(P)
-    cl_poles = np.linalg.eigvals(np.asarray(CL.A, float)) if CL.nstates else np.zeros(0)
-    max_re = float(cl_poles.real.max()) if cl_poles.size else float("-inf")
+    max_re = _max_pole_real(CL)
     if near.size:
         notes.append(f"near-axis poles of the plant at {', '.join(f'{p.real:.3g}' for p in near)} rad/s: "
                      f"left out of the D-step grid (from {grid.min():.3g} rad/s), covered by the final "
