@@ -35,8 +35,8 @@ import numpy as np
 from ._validation import Integer, Options, Real, validate_params
 from .errors import ModelError
 
-__all__ = ["FRF", "FRFFileError", "FRFMatrix", "sweep_frequencies", "frequency_grid", "local_extrema",
-           "INPUT_UNITS", "OUTPUT_UNITS", "DIRECTIONS"]
+__all__ = ["FRF", "FRFFileError", "FRFMatrix", "sweep_frequencies", "frequency_grid", "resonance_points",
+           "local_extrema", "INPUT_UNITS", "OUTPUT_UNITS", "DIRECTIONS"]
 
 #: Allowed input quantities and their unit (the SI unit; factor to SI is 1).
 INPUT_UNITS: dict[str, dict[str, float]] = {"force": {"N": 1.0}, "current": {"A": 1.0}}
@@ -440,8 +440,7 @@ def frequency_grid(band=None, n: int = 400, *, poles=(), margin=(10.0, 10.0), sp
         for m in np.abs(poles[poles != 0]):
             w = w[np.abs(w / m - 1.0) > avoid]
     if resonance_offsets is not None:
-        extra = _resonance_points(poles, resonance_offsets)
-        w = np.concatenate([w, extra[(extra >= lo) & (extra <= hi)]])
+        w = np.concatenate([w, resonance_points(poles, resonance_offsets, (lo, hi))])
     return np.unique(w)
 
 
@@ -457,12 +456,43 @@ def _grid_band(band, poles, margin):
     return lo, hi
 
 
-def _resonance_points(poles, offsets):
-    """Points at the oscillating poles' frequencies (see :func:`frequency_grid`)."""
+def resonance_points(poles, offsets=(-1.0, 0.0, 1.0), band=None) -> np.ndarray:
+    r"""Frequencies that bracket the resonances of ``poles``.
+
+    Each oscillating pole :math:`p` gives :math:`|\Im p| + k |\Re p|` for each
+    ``k`` in ``offsets`` (:math:`|\Re p|` is the half-power half-width, so a
+    resonance cannot fall between the points of ``(-1, 0, 1)``); an undamped
+    pole gives :math:`|\Im p|(1 \pm 10^{-3})` instead, its gain being
+    infinite at :math:`|\Im p|`.
+
+    Parameters
+    ----------
+    poles : array_like
+        Poles (complex); real ones add nothing.
+    offsets : sequence of float
+        Multiples of the half-width either side of each damped resonance.
+    band : (float, float), optional
+        Keep only the points in ``[lo, hi]`` (default: every point above 0).
+
+    Returns
+    -------
+    ndarray
+        The points, unsorted, possibly repeated.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from mutext.response import resonance_points
+    >>> resonance_points(np.array([-0.1 + 10j, -0.1 - 10j]), (-1, 0, 1)).round(6)
+    array([ 9.9, 10. , 10.1,  9.9, 10. , 10.1])
+    """
+    poles = np.atleast_1d(np.asarray(poles, complex))
     osc = poles[poles.imag != 0]
     undamped = np.abs(osc.real) <= 1e-12 * np.abs(osc)
     w0 = np.abs(osc.imag[undamped])
     damped = osc[~undamped]
     k = np.asarray(offsets, float)
-    return np.concatenate([(np.abs(damped.imag)[:, None] + np.abs(damped.real)[:, None] * k).ravel(),
-                           w0 * (1 - 1e-3), w0 * (1 + 1e-3)])
+    w = np.concatenate([(np.abs(damped.imag)[:, None] + np.abs(damped.real)[:, None] * k).ravel(),
+                        w0 * (1 - 1e-3), w0 * (1 + 1e-3)])
+    lo, hi = (0.0, np.inf) if band is None else (float(band[0]), float(band[1]))
+    return w[(w > 0) & (w >= lo) & (w <= hi)]

@@ -13,6 +13,7 @@ import numpy as np
 
 from .._validation import Integer, Options, validate_params
 from ..errors import IllPosedError, ModelError, SolverError
+from ..response import frequency_grid, resonance_points
 from ._bounds import _both, _both_lower
 from ._certificate import MuUpper
 from ._fast import _DGParams, _fast_at, _fast_polish
@@ -22,19 +23,9 @@ from ._structure import BlockStructure, _as_structure
 from ._upper import _certify, mu_upper
 
 
-def _resonance_points(poles, lo: float = 0.0, hi: float = np.inf) -> np.ndarray:
-    r"""Frequencies :math:`|\Im p| + k|\Re p|`, :math:`k\in\{0, \pm\frac12, \pm 1, \pm 2\}`,
-    of the oscillatory poles with :math:`|\Im p|` in ``[lo, hi]``: a resonance of
-    half-power width :math:`2|\Re p|` cannot fall between them."""
-    pts = []
-    for p in poles:
-        wi = abs(p.imag)
-        if wi > 0 and lo <= wi <= hi:
-            pts.append(wi + abs(p.real) * np.array([-2, -1, -0.5, 0, 0.5, 1, 2]))
-    if not pts:
-        return np.zeros(0)
-    w = np.concatenate(pts)
-    return w[w > 0]
+#: Multiples of a resonance's half-width sampled around it (``response.resonance_points``): a
+#: resonance of half-power width :math:`2|\Re p|` cannot fall between them.
+RESONANCE_OFFSETS = (-2.0, -1.0, -0.5, 0.0, 0.5, 1.0, 2.0)
 
 
 def _poles(sys) -> np.ndarray:
@@ -44,8 +35,10 @@ def _poles(sys) -> np.ndarray:
 def default_grid(sys, n: int = 200, decades: float = 1.5) -> np.ndarray:
     """Log-spaced frequencies spanning the pole magnitudes, plus each pole's frequency.
 
-    Lightly damped poles (resonances) get extra points at :math:`|\\Im p|` and
-    :math:`|\\Im p| \\pm k|\\Re p|` so that a narrow peak is not stepped over.
+    :func:`mutext.response.frequency_grid` over the poles of ``sys``: lightly
+    damped poles (resonances) get extra points at :math:`|\\Im p|` and
+    :math:`|\\Im p| \\pm k|\\Re p|`, :math:`k \\in \\{\\frac12, 1, 2\\}`, so that a
+    narrow peak is not stepped over (undamped poles: 0.1 % either side).
 
     Parameters
     ----------
@@ -66,15 +59,8 @@ def default_grid(sys, n: int = 200, decades: float = 1.5) -> np.ndarray:
     (True, True)
     """
     from ..lti import as_ss
-    sys = as_ss(sys)
-    poles = _poles(sys)
-    mags = np.abs(poles[np.abs(poles) > 0])
-    if mags.size:
-        lo, hi = mags.min() / 10 ** decades, mags.max() * 10 ** decades
-    else:
-        lo, hi = 1e-2, 1e2
-    w = np.concatenate([np.logspace(np.log10(lo), np.log10(hi), n), _resonance_points(poles)])
-    return np.unique(w[w > 0])
+    return frequency_grid(n=n, poles=_poles(as_ss(sys)), margin=(10.0 ** decades, 10.0 ** decades),
+                          resonance_offsets=RESONANCE_OFFSETS)
 
 
 @dataclass
@@ -320,8 +306,8 @@ def mu_sweep(sys, structure: BlockStructure, omega=None, *, method: str = "auto"
         raise ModelError(f"lower must be 'peaks', 'all' or 'none', got {lower!r}")
     omega = np.unique(omega)
     if refine and omega.size >= 2:
-        extra = _resonance_points(_poles(sysss), omega[0], omega[-1])
-        omega = np.unique(np.concatenate([omega, extra[(extra >= omega[0]) & (extra <= omega[-1])]]))
+        extra = resonance_points(_poles(sysss), RESONANCE_OFFSETS, (omega[0], omega[-1]))
+        omega = np.unique(np.concatenate([omega, extra]))
     rng = np.random.default_rng(rng)
 
     def response(w):
