@@ -47,7 +47,9 @@ The modules form layers, each importing only from its own and lower ones
 (``_solver``: every convex program goes to the conic solver through it, with its
 options for the accuracy asked for); lti, response;
 hinf, mu, frfit; dk, uncertain, rotor; mbi, rig, sysid, diagnose, hide, uff,
-batch, report; examples; demos, plots, grading, commands; cli.
+batch, report; examples; demos, plots, grading, commands; cli and, above all, this
+facade, whose entry points are named as strings and imported on first use (the
+layering test reads such registries as imports).
 """
 
 from .errors import (IllPosedError, InfeasibleError, ModelError, MutextError,
@@ -55,24 +57,25 @@ from .errors import (IllPosedError, InfeasibleError, ModelError, MutextError,
 
 __version__ = "0.1.0"
 
-#: The common entry points, importable from the top level (``from mutext import hinfsyn``).  Each is
+#: The common entry points, importable from the top level (``from mutext import hinfsyn``), with the
+#: module (relative to the package) that holds each.  Each is
 #: loaded on first use: ``import mutext`` stays light, and cvxpy, slycot or CasADi are imported only
 #: by the modules that need them.
 _ENTRY_POINTS = {
     # state space and frequency response
-    "ss": "lti", "mck_to_ss": "lti", "lft_lower": "lti", "lft_upper": "lti", "freqresp": "lti",
-    "hinf_norm": "lti", "stability": "lti",
-    "FRF": "response", "FRFMatrix": "response", "frequency_grid": "response",
-    "sweep_frequencies": "response",
+    "ss": ".lti", "mck_to_ss": ".lti", "lft_lower": ".lti", "lft_upper": ".lti", "freqresp": ".lti",
+    "hinf_norm": ".lti", "stability": ".lti",
+    "FRF": ".response", "FRFMatrix": ".response", "frequency_grid": ".response",
+    "sweep_frequencies": ".response",
     # robust control
-    "hinfsyn": "hinf", "BlockStructure": "mu", "mu_upper": "mu", "mu_lower": "mu", "mu_bounds": "mu",
-    "mu_sweep": "mu", "dk_iteration": "dk", "dgk_iteration": "dk", "refine_controller": "dk",
-    "UncertainParameter": "uncertain", "uncertain_mck": "uncertain",
+    "hinfsyn": ".hinf", "BlockStructure": ".mu", "mu_upper": ".mu", "mu_lower": ".mu", "mu_bounds": ".mu",
+    "mu_sweep": ".mu", "dk_iteration": ".dk", "dgk_iteration": ".dk", "refine_controller": ".dk",
+    "UncertainParameter": ".uncertain", "uncertain_mck": ".uncertain",
     # identification and fitting
-    "identify": "mbi", "wz_floor": "mbi", "fit_frf": "frfit", "resonances": "frfit",
+    "identify": ".mbi", "wz_floor": ".mbi", "fit_frf": ".frfit", "resonances": ".frfit",
     # models, measurements, diagnosis
-    "load_model": "rotor", "loads_model": "rotor", "read_frf": "rig", "write_frf": "rig",
-    "read_frfs": "rig", "measure": "rig", "measure_rotor": "rig", "read_uff58": "uff",
+    "load_model": ".rotor", "loads_model": ".rotor", "read_frf": ".rig", "write_frf": ".rig",
+    "read_frfs": ".rig", "measure": ".rig", "measure_rotor": ".rig", "read_uff58": ".uff",
     # (the diagnosis is ``mutext.diagnose.diagnose``: the package ``mutext.diagnose`` holds the name)
 }
 
@@ -86,7 +89,7 @@ def __getattr__(name):
     if module is None:
         raise AttributeError(f"module 'mutext' has no attribute {name!r}")
     import importlib
-    value = getattr(importlib.import_module(f".{module}", __name__), name)
+    value = getattr(importlib.import_module(module, __name__), name)
     globals()[name] = value
     return value
 

@@ -11,7 +11,7 @@ import mutext
 @pytest.mark.parametrize("name", sorted(mutext._ENTRY_POINTS))
 def test_entry_point_is_the_modules_object(name):
     import importlib
-    module = importlib.import_module(f"mutext.{mutext._ENTRY_POINTS[name]}")
+    module = importlib.import_module(mutext._ENTRY_POINTS[name], "mutext")
     assert getattr(mutext, name) is getattr(module, name)
     assert name in mutext.__all__ and name in dir(mutext)
 

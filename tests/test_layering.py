@@ -10,17 +10,24 @@ the imports between units must not form a cycle)::
     mbi, rig, sysid, diagnose/, hide, uff, batch, report
     examples/
     demos/, plots, diagrams, grading/, commands/, progress
-    cli
+    cli, the package's facade (``mutext/__init__.py``: every entry point, loaded on first use)
 
 A *unit* is the first name below ``mutext`` (``mutext.rotor.crack`` is unit
 ``rotor``).  Both module-level and function-local imports count: a local
-import hides an edge of the graph, it does not remove it.  No two modules
+import hides an edge of the graph, it does not remove it.  So do the
+registries that name modules as strings for ``importlib.import_module`` (the
+CLI's demos and commands, the facade's entry points, the grading package's
+lazy names): in a module that calls ``import_module``, every module path
+written as a string in a module-level dict (``"mutext.demos.rotor"``, or
+``".lti"`` relative to the package) is an import at its line.  No two modules
 import each other, directly or around a loop.  The check is a plain AST walk
 (no import-linter), so it runs without importing the package.
 """
 from __future__ import annotations
 
 import ast
+import importlib.util
+import re
 from pathlib import Path
 
 import pytest
@@ -35,11 +42,10 @@ LAYERS = [
     {"mbi", "rig", "sysid", "diagnose", "hide", "uff", "batch", "report"},
     {"examples"},
     {"demos", "plots", "diagrams", "grading", "commands", "progress"},
-    {"cli"},
+    {"cli", ""},
 ]
+# ``""`` is the package itself: its facade names entry points of every layer (no module imports it)
 LAYER = {unit: k for k, units in enumerate(LAYERS) for unit in units}
-# ``mutext/__init__.py`` re-exports the errors only: it sits with them
-LAYER[""] = 0
 
 #: Known violations in modules being reworked elsewhere, as (file, imported unit).
 #: Empty today; an entry here names its follow-up issue and is removed with it.
@@ -76,6 +82,34 @@ def imports(source: str, module: str, is_package: bool = False, modules=frozense
             for alias in node.names:
                 sub = f"{target}.{alias.name}"
                 yield node.lineno, sub if sub in modules or target == PACKAGE.name else target
+    yield from registry_imports(source, package)
+
+
+_MODULE_PATH = re.compile(r"^(mutext(\.\w+)+|\.+\w+(\.\w+)*)$")
+
+
+def registry_imports(source: str, package: str):
+    """``(line, target)`` for every module named as a string in a module-level dict of a module that
+    calls ``import_module`` (a registry: ``{"rotor": ("mutext.demos.rotor", "...")}`` or
+    ``{"hinfsyn": ".hinf"}``, relative names resolved against ``package``)."""
+    tree = ast.parse(source)
+    calls = any(isinstance(n, ast.Call) and getattr(n.func, "attr", getattr(n.func, "id", None)) == "import_module"
+                for n in ast.walk(tree))
+    if not calls:
+        return
+    for stmt in tree.body:
+        value = stmt.value if isinstance(stmt, (ast.Assign, ast.AnnAssign)) else None
+        if not isinstance(value, ast.Dict):
+            continue
+        for v in value.values:
+            for c in ([v] if isinstance(v, ast.Constant) else getattr(v, "elts", [])):
+                if isinstance(c, ast.Constant) and isinstance(c.value, str) and _MODULE_PATH.match(c.value):
+                    name = c.value
+                    if name.startswith("."):
+                        level = len(name) - len(name.lstrip("."))
+                        base = package.split(".")[: len(package.split(".")) - level + 1]
+                        name = ".".join(base + [name.lstrip(".")])
+                    yield c.lineno, name
 
 
 def unit(dotted: str) -> str | None:
@@ -164,6 +198,16 @@ def test_no_import_cycle_between_modules():
     assert not found, "import cycles between modules:\n" + "\n".join(found)
 
 
+def test_registries_are_seen_and_name_real_modules():
+    # the CLI's registries and the facade are edges of the graph, and each string names a module that exists
+    found = [(f, dst) for f, _, src, dst in module_edges()
+             if f in ("mutext/cli.py", "mutext/__init__.py", "mutext/grading/__init__.py")]
+    targets = {dst for _, dst in found}
+    assert {"mutext.demos.rotor", "mutext.commands.diagnose", "mutext.hinf", "mutext.grading.spec"} <= targets
+    missing = sorted(t for t in targets if importlib.util.find_spec(t) is None)
+    assert not missing, f"registries name modules that do not exist: {missing}"
+
+
 def test_every_unit_has_a_layer():
     units = {unit(module_name(p)) for p in PACKAGE.rglob("*.py")}
     assert units <= set(LAYER), f"units missing from LAYERS: {sorted(units - set(LAYER))}"
@@ -190,6 +234,21 @@ def test_check_reports_a_deliberate_back_reference(tmp_path):
     })
     bad = upward(edges(root))
     assert bad == ["mutext/rotor/demo.py:4: rotor (layer 3) imports cli (layer 7)"]
+
+
+def test_check_reports_a_back_reference_through_a_registry(tmp_path):
+    # a library module that loads a demo by name: no import statement, still an upward edge
+    root = _tree(tmp_path, {
+        "__init__.py": "",
+        "mu/__init__.py": ("import importlib\n\nSHOWS = {\"peak\": (\"mutext.demos.peak\", \"a demo\")}\n\n"
+                           "def show(name):\n    return importlib.import_module(SHOWS[name][0])\n"),
+        "demos/__init__.py": "",
+        "demos/peak.py": "",
+    })
+    assert upward(edges(root)) == ["mutext/mu/__init__.py:3: mu (layer 2) imports demos (layer 6)"]
+    # the same dict without import_module is data, not an import
+    (root / "mu/__init__.py").write_text("SHOWS = {\"peak\": (\"mutext.demos.peak\", \"a demo\")}\n")
+    assert upward(edges(root)) == []
 
 
 @pytest.mark.parametrize("source, target", [
