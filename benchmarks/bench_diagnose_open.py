@@ -82,15 +82,16 @@ confidently wrong, false alarms <= 2 %.
 
 Usage::
 
-    python benchmarks/bench_diagnose_open.py                   # 1 % noise, 176 cases (5 seeds), about 25 min/job
+    python benchmarks/bench_diagnose_open.py                   # 1 % noise, 202 cases (5 seeds), about 25 min/job
     python benchmarks/bench_diagnose_open.py --quick           # a handful of cases (about a minute)
     python benchmarks/bench_diagnose_open.py --noise 0.003 0.01 0.03 --jobs 2 --json rows.json
     python benchmarks/bench_diagnose_open.py --categories out_of_library --seeds 2
 
 Counts per example and noise level with ``--seeds S`` (default 5): in-library S
-per kind (9 kinds), two-effect 3 S, out-of-library ceil(0.4 S) per kind (9 kinds),
-none 2 S.  With S = 5 and both examples: 90 in-library, 30 two-effect,
-36 out-of-library and 20 none cases per noise level.
+per kind (11 kinds: the generator's 9 and :data:`NOW_IN_LIBRARY`), two-effect 3 S,
+out-of-library ceil(0.6 S) per kind (7 kinds), none 2 S.  With S = 5 and both
+examples: 110 in-library, 30 two-effect, 42 out-of-library and 20 none cases per
+noise level.
 """
 from __future__ import annotations
 
@@ -138,7 +139,7 @@ def case_list(examples, noises, seeds: int, first: int, categories, quick: bool)
             for cat in categories:
                 kinds = QUICK[cat] if quick else CATEGORIES[cat]
                 per = 1 if quick else {"in_library": seeds, "two_effect": 3 * seeds,
-                                       "out_of_library": math.ceil(0.4 * seeds), "none": 2 * seeds}[cat]
+                                       "out_of_library": math.ceil(0.6 * seeds), "none": 2 * seeds}[cat]
                 for k in kinds:
                     for s in range(first, first + per):
                         out.append((e, cat, k, s, n))
