@@ -64,6 +64,22 @@ def _settle(pr: PeriodicRotor, settle_s: float, revolutions: int):
     return float(settle_s), revolutions * pr.period
 
 
+def _correlated(pr: PeriodicRotor, hr: HarmonicResponse, k: int, t_s: float, T: float,
+                excitation_phase: float, descending: bool = False) -> FRFMatrix:
+    r"""The analyzer's response at order ``k`` (module docstring): :math:`\hat H_k = H_k +
+    e^{-2j\varphi}\sum_{k'}\overline{H_{k'}}\,\langle e^{-j(2\omega + (k+k')\Omega)t}\rangle` over
+    the window :math:`[t_s, t_s + T]`, :math:`k'` over all the orders of ``hr``; ``k = 0`` is
+    :math:`\hat H`.  The sum runs up the orders :math:`k'`, or down them with ``descending`` (the
+    order :func:`analyzer_frf` has always summed in, kept for its results to the last bit)."""
+    w = 2 * np.pi * hr.freqs_hz
+    N = hr.harmonics
+    H = hr(k).copy()
+    for kp in (range(N, -N - 1, -1) if descending else range(-N, N + 1)):
+        avg = _window_average(-(2 * w + (k + kp) * pr.speed), t_s, T)
+        H += np.exp(-2j * excitation_phase) * np.conj(hr(kp)) * avg
+    return FRFMatrix(hr.freqs_hz, H, list(pr.inputs), list(pr.outputs), pr.speed, dict(pr.ports))
+
+
 def analyzer_frf(model, freqs_hz, *, harmonics: int = 6, revolutions: int = ANALYZER["revolutions"],
                  settle_s: float = ANALYZER["settle_s"], excitation_phase: float = 0.0,
                  inputs=None, outputs=None) -> FRFMatrix:
@@ -108,13 +124,7 @@ def analyzer_frf(model, freqs_hz, *, harmonics: int = 6, revolutions: int = ANAL
     pr = _as_periodic(model, inputs, outputs)
     hr = harmonic_response(pr, freqs_hz, harmonics=harmonics)
     t_s, T = _settle(pr, settle_s, revolutions)
-    w = 2 * np.pi * hr.freqs_hz
-    H = hr(0).copy()
-    N = hr.harmonics
-    for k in range(-N, N + 1):
-        avg = _window_average(k * pr.speed - 2 * w, t_s, T)
-        H += np.exp(-2j * excitation_phase) * np.conj(hr(-k)) * avg
-    return FRFMatrix(hr.freqs_hz, H, list(pr.inputs), list(pr.outputs), pr.speed, dict(pr.ports))
+    return _correlated(pr, hr, 0, t_s, T, excitation_phase, descending=True)
 
 
 def analyzer_combination(model, freqs_hz, orders=(-2, -1, 1, 2), *, harmonics: int = 6,
@@ -174,15 +184,7 @@ def analyzer_combination(model, freqs_hz, orders=(-2, -1, 1, 2), *, harmonics: i
     N = N + max(abs(k) for k in ks)
     hr = harmonic_response(pr, freqs_hz, harmonics=N)
     t_s, T = _settle(pr, settle_s, revolutions)
-    w = 2 * np.pi * hr.freqs_hz
-    out = {}
-    for k in ks:
-        H = hr(k).copy()
-        for kp in range(-N, N + 1):
-            avg = _window_average(-(2 * w + (k + kp) * pr.speed), t_s, T)
-            H += np.exp(-2j * excitation_phase) * np.conj(hr(kp)) * avg
-        out[k] = FRFMatrix(hr.freqs_hz, H, list(pr.inputs), list(pr.outputs), pr.speed, dict(pr.ports))
-    return out
+    return {k: _correlated(pr, hr, k, t_s, T, excitation_phase) for k in ks}
 
 
 def harmonic_convergence(model, freqs_hz, *, harmonics: Sequence[int] = (0, 1, 2, 3, 4, 6, 8),
