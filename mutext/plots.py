@@ -52,6 +52,21 @@ def systems_grid(*systems, decades: float = 1.5, n: int = 800) -> np.ndarray:
                                    margin=(10.0 ** decades, 10.0 ** decades), resonance_offsets=(0.0,))
 
 
+def _system_and_grid(sys, omega, *others):
+    """``sys`` as a state space and the frequencies [rad/s] to draw it on: ``omega`` as given, or
+    :func:`systems_grid` over ``sys`` and ``others`` when it is None."""
+    sys = as_ss(sys)
+    return sys, np.asarray(systems_grid(sys, *others) if omega is None else omega, float)
+
+
+def _finish(fig, title=None, **kw):
+    """A figure's last step: its title (``suptitle``, with ``kw``) when given, then the tight layout."""
+    if title:
+        fig.suptitle(title, **kw)
+    fig.tight_layout()
+    return fig
+
+
 def bode_mag(ax, sys, omega, out_index: int = 0, in_index: int = 0, db: bool = True, **kw):
     """Plot ``|G_ij(j w)|`` of one channel on ``ax`` (dB if ``db``, else absolute).
 
@@ -152,11 +167,8 @@ def closed_loop_figure(CL, omega=None, P=None, input_names=None, output_names=No
     matplotlib.figure.Figure
     """
     plt = _plt()
-    CL = as_ss(CL)
+    CL, omega = _system_and_grid(CL, omega, *([] if P is None else [P]))
     nz, nw = CL.noutputs, CL.ninputs
-    if omega is None:
-        omega = systems_grid(CL) if P is None else systems_grid(CL, P)
-    omega = np.asarray(omega, float)
     input_names = input_names or list(CL.input_labels)
     output_names = output_names or list(CL.output_labels)
     # at most 7 in wide: the book's text column, so the text is not scaled down
@@ -183,10 +195,7 @@ def closed_loop_figure(CL, omega=None, P=None, input_names=None, output_names=No
                 ax.set_xlabel("frequency [rad/s]")
     if G0 is not None:
         axes[0, 0].legend(fontsize=8)
-    if title:
-        fig.suptitle(title)
-    fig.tight_layout()
-    return fig
+    return _finish(fig, title)
 
 
 def controller_figure(K, omega=None, title=None):
@@ -206,17 +215,13 @@ def controller_figure(K, omega=None, title=None):
     matplotlib.figure.Figure
     """
     plt = _plt()
-    K = as_ss(K)
-    omega = systems_grid(K) if omega is None else np.asarray(omega, float)
+    K, omega = _system_and_grid(K, omega)
     fig, (a1, a2) = plt.subplots(2, 1, figsize=(6.4, 5.0), sharex=True)
     bode_mag(a1, K, omega)
     a1.set_xlabel("")
     a1.set_ylabel("|K| [dB re 1 N/m]")
     bode_phase(a2, K, omega)
-    if title:
-        fig.suptitle(title)
-    fig.tight_layout()
-    return fig
+    return _finish(fig, title)
 
 
 def sigma_figure(CL, omega=None, levels=None, title=None):
@@ -238,8 +243,7 @@ def sigma_figure(CL, omega=None, levels=None, title=None):
     matplotlib.figure.Figure
     """
     plt = _plt()
-    CL = as_ss(CL)
-    omega = systems_grid(CL) if omega is None else np.asarray(omega, float)
+    CL, omega = _system_and_grid(CL, omega)
     fig, ax = plt.subplots(figsize=(6.4, 3.6))
     sigma_plot(ax, CL, omega, label="closed loop")
     styles = iter([":", "--", "-.", (0, (1, 3))])
@@ -371,10 +375,7 @@ def mbi_figure(result, true_systems, Du=None, title=None):
         a.set_xlabel("frequency [rad/s]")
         a.grid(True, which="both", alpha=0.3)
         a.xaxis.set_minor_formatter(NullFormatter())     # a band of under two decades labels its minor ticks
-    if title:
-        fig.suptitle(title)
-    fig.tight_layout()
-    return fig
+    return _finish(fig, title)
 
 
 def sideband_figure(frf, evidence, reference=None, title=None, band=None):
@@ -716,7 +717,4 @@ def orbit_figure(orbits, *, titles=None, title=None):
         ax.set_ylabel("y [µm]")
         ax.grid(True, alpha=0.3)
         ax.set_title((titles[j] if titles else o.label), fontsize=8)
-    if title:
-        fig.suptitle(title, fontsize=10)
-    fig.tight_layout()
-    return fig
+    return _finish(fig, title, fontsize=10)
