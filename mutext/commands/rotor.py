@@ -65,21 +65,6 @@ def _port(text: str):
     return int(text) if text.isdigit() else text
 
 
-def _freqs(text: str):
-    from ..errors import UsageError
-    parts = text.split(":")
-    try:
-        if len(parts) != 3:
-            raise ValueError
-        a, b, n = float(parts[0]), float(parts[1]), int(parts[2])
-    except ValueError:
-        raise UsageError(f"--freqs {text!r}: expected START:STOP:COUNT in Hz, e.g. 20:225:4101") from None
-    if not (math.isfinite(a) and math.isfinite(b) and 0 <= a < b and n >= 3):
-        raise UsageError(f"--freqs {text!r}: need 0 <= START < STOP and COUNT >= 3")
-    import numpy as np
-    return np.linspace(a, b, n)
-
-
 def run_whirl(args) -> int:
     """``mutext rotor whirl``: the directional FRFs' resonances with their whirl sense.
 
@@ -99,7 +84,7 @@ def run_whirl(args) -> int:
     from ..jsonio import print_json
     from ..rig import measure_rotor
     from ..rotor import load_model, whirl_peaks
-    f = _freqs(args.freqs)
+    f = parse_grid(args.freqs, "--freqs", "Hz", example="20:225:4101", least=3, lowest=0.0)
     if args.speed is not None and not (math.isfinite(args.speed) and args.speed >= 0):
         from ..errors import UsageError
         raise UsageError(f"--speed {args.speed}: expected a non-negative speed in rpm")
@@ -129,6 +114,59 @@ def run_whirl(args) -> int:
     return 0
 
 
+def parse_grid(text: str, option: str, unit: str, *, example: str, least: int = 2, lowest: float | None = None,
+               lists: bool = False):
+    """An option's values: ``START:STOP:COUNT`` (COUNT evenly spaced, both ends included:
+    :func:`numpy.linspace`) or, with ``lists``, a comma-separated list -> array of float, or a
+    UsageError naming ``option``.
+
+    Parameters
+    ----------
+    text : str
+        The option's text.
+    option : str
+        The option's name as typed (``"--freqs"``), for the message.
+    unit : str
+        The unit of the values (``"Hz"``, ``"rpm"``), for the message.
+    example : str
+        A valid ``START:STOP:COUNT``, for the message.
+    least : int, optional
+        The smallest COUNT.
+    lowest : float, optional
+        The smallest START (default: none).
+    lists : bool, optional
+        Whether a comma-separated list is accepted too.
+
+    Examples
+    --------
+    >>> from mutext.commands.rotor import parse_grid
+    >>> parse_grid("20:30:3", "--freqs", "Hz", example="20:225:4101").tolist()
+    [20.0, 25.0, 30.0]
+    """
+    import numpy as np
+
+    from ..errors import UsageError
+    t = str(text).strip()
+    try:
+        if ":" in t or not lists:
+            parts = t.split(":")
+            if len(parts) != 3:
+                raise ValueError
+            a, b, n = float(parts[0]), float(parts[1]), int(parts[2])
+            if n < least or not (math.isfinite(a) and math.isfinite(b)) or b <= a or (lowest is not None and a < lowest):
+                raise ValueError
+            return np.linspace(a, b, n)
+        vals = [float(x) for x in t.split(",") if x.strip()]
+        if not vals or not all(math.isfinite(v) for v in vals):
+            raise ValueError
+        return np.array(vals)
+    except ValueError:
+        start = "STOP > START" if lowest is None else f"STOP > START >= {lowest:g}"
+        also = f", or a comma-separated list of {option.lstrip('-')} in {unit}" if lists else ""
+        raise UsageError(f"{option} {text!r}: expected START:STOP:COUNT in {unit} with {start} and COUNT >= {least} "
+                         f"(e.g. {example}){also}") from None
+
+
 def parse_speeds(text: str):
     """``"0:3000:31"`` or ``"0,500,1000"`` (rpm) -> list of float, or UsageError naming the option.
 
@@ -143,24 +181,7 @@ def parse_speeds(text: str):
     >>> parse_speeds("0:3000:4"), parse_speeds("600, 1200")
     ([0.0, 1000.0, 2000.0, 3000.0], [600.0, 1200.0])
     """
-    from ..errors import UsageError
-    t = str(text).strip()
-    try:
-        if ":" in t:
-            parts = t.split(":")
-            if len(parts) != 3:
-                raise ValueError
-            a, b, n = float(parts[0]), float(parts[1]), int(parts[2])
-            if n < 2 or not (math.isfinite(a) and math.isfinite(b)) or b <= a:
-                raise ValueError
-            return [a + (b - a) * i / (n - 1) for i in range(n)]
-        vals = [float(x) for x in t.split(",") if x.strip()]
-        if not vals or not all(math.isfinite(v) for v in vals):
-            raise ValueError
-        return vals
-    except ValueError:
-        raise UsageError(f"--speeds {text!r}: expected START:STOP:COUNT in rpm with STOP > START and COUNT >= 2 "
-                         "(e.g. 0:3000:31), or a comma-separated list of speeds in rpm") from None
+    return parse_grid(text, "--speeds", "rpm", example="0:3000:31", lists=True).tolist()
 
 
 def _orders(text: str):
