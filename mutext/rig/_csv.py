@@ -76,6 +76,15 @@ def _header(path, lines) -> tuple[dict[str, tuple[str, int]], int]:
     return header, i
 
 
+def _one_of(path, key, entry, allowed, what: str) -> str:
+    """The value of a header ``entry`` ``(value, line)`` that must be one of ``allowed``, or an
+    :class:`FRFFileError` naming the ``key``, the line and the ``allowed`` values."""
+    value, ln = entry
+    if value not in allowed:
+        raise FRFFileError(path, ln, key, f"unknown {what} {value!r}; allowed: {', '.join(allowed)}")
+    return value
+
+
 def _channel(path, header, units) -> _Channel:
     """The required keys of the header read: the stations, the quantities and their units (read as
     ``units`` says), which must agree."""
@@ -87,10 +96,7 @@ def _channel(path, header, units) -> _Channel:
                             "input_station")
     out_station = _parse_int(header["output_station"][0], path, header["output_station"][1],
                              "output_station")
-    in_q, ln = header["input_quantity"]
-    if in_q not in INPUT_UNITS:
-        raise FRFFileError(path, ln, "input_quantity", f"unknown quantity {in_q!r}; allowed: "
-                                                       f"{', '.join(INPUT_UNITS)}")
+    in_q = _one_of(path, "input_quantity", header["input_quantity"], INPUT_UNITS, "quantity")
     in_u, ln = header["input_unit"]
     try:
         in_units = reference_units(relabel(in_u, units))
@@ -99,10 +105,7 @@ def _channel(path, header, units) -> _Channel:
     except ValueError as exc:
         raise _units_error(path, ln, "input_unit", in_u, f"{in_q} input", exc, _INPUT_UNIT_NAMES[in_q],
                            "N" if in_q == "force" else "A") from None
-    out_q, ln = header["output_quantity"]
-    if out_q not in _OUTPUT_QUANTITIES:
-        raise FRFFileError(path, ln, "output_quantity", f"unknown quantity {out_q!r}; allowed: "
-                                                        f"{', '.join(_OUTPUT_QUANTITIES)}")
+    out_q = _one_of(path, "output_quantity", header["output_quantity"], _OUTPUT_QUANTITIES, "quantity")
     out_u, ln = header["output_unit"]
     try:
         out_units = motion_units(relabel(out_u, units))
@@ -125,10 +128,7 @@ def _options(path, header) -> tuple[float | None, dict, dict]:
         speed = _parse_float(header["speed_hz"][0], path, header["speed_hz"][1], "speed_hz")
     dirs = {}
     for key in ("input_direction", "output_direction"):
-        v, ln = header.get(key, ("x", None))
-        if v not in DIRECTIONS:
-            raise FRFFileError(path, ln, key, f"unknown direction {v!r}; allowed: {', '.join(DIRECTIONS)}")
-        dirs[key] = v
+        dirs[key] = _one_of(path, key, header.get(key, ("x", None)), DIRECTIONS, "direction")
     port_names = {key: header[key][0] for key in ("input_name", "output_name") if key in header}
     return speed, dirs, port_names
 
