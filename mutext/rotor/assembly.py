@@ -132,14 +132,50 @@ class ModalDamping:
             raise ModelError(f"modal damping ratio must be in [0, 1), got {self.ratio!r}")
 
 
-def _sx_add(X: ca.SX, idx: list[int], local, who: str, what: str) -> ca.SX:
-    local = ca.SX(local)
-    n = len(idx)
-    if local.shape != (n, n):
-        raise ModelError(f"{who}: {what} matrix is {local.shape[0]}x{local.shape[1]} but the element has "
-                         f"{n} DOFs")
-    X[idx, idx] = X[idx, idx] + local
-    return X
+def _dense(dm: ca.DM) -> np.ndarray:
+    """A CasADi matrix as a dense numpy array, filled from its nonzeros (``DM.full`` goes through a
+    Python list of every entry: a tenth of a second for a 200-element rotor's matrices)."""
+    out = np.zeros(dm.shape)
+    r, c = dm.sparsity().get_triplet()
+    out[r, c] = dm.nonzeros()
+    return out
+
+
+class _Assembler:
+    """Sums element matrices into a global ``n x n`` SX matrix in one step.
+
+    Each element's local matrix is kept with its global DOFs; :meth:`matrix` sums the entries that
+    share a global position (one sparse product) and builds the matrix from the triplets: setting
+    the global matrix element by element cost a copy of its sparsity per element."""
+
+    def __init__(self, n: int):
+        self.n = n
+        self.rows: list[np.ndarray] = []
+        self.cols: list[np.ndarray] = []
+        self.values: list = []
+
+    def add(self, idx: list[int], local, who: str, what: str) -> None:
+        local = ca.SX(local)
+        k = len(idx)
+        if local.shape != (k, k):
+            raise ModelError(f"{who}: {what} matrix is {local.shape[0]}x{local.shape[1]} but the element has "
+                             f"{k} DOFs")
+        idx = np.asarray(idx, dtype=np.int64)
+        # column-major, as ca.vec orders the entries
+        self.rows.append(np.tile(idx, k))
+        self.cols.append(np.repeat(idx, k))
+        self.values.append(ca.vec(local))
+
+    def matrix(self) -> ca.SX:
+        if not self.values:
+            return ca.SX(self.n, self.n)
+        r, c = np.concatenate(self.rows), np.concatenate(self.cols)
+        key = c * self.n + r
+        uniq, where = np.unique(key, return_inverse=True)
+        summing = ca.DM(ca.Sparsity.triplet(uniq.size, key.size, where.tolist(), list(range(key.size))),
+                        np.ones(key.size))
+        entries = ca.densify(ca.mtimes(summing, ca.vertcat(*self.values)))
+        return ca.SX.triplet((uniq % self.n).tolist(), (uniq // self.n).tolist(), entries, self.n, self.n)
 
 
 class Structure:
@@ -236,14 +272,15 @@ class Structure:
 
         # assembly
         n = self.layout.ndof
-        M, C, K, G = ca.SX(n, n), ca.SX(n, n), ca.SX(n, n), ca.SX(n, n)
+        parts = {meth: _Assembler(n) for meth in ("mass_matrix", "damping_matrix", "stiffness_matrix",
+                                                  "gyroscopic_matrix")}
         for el in self.elements:
             idx = el.dofs(self.layout)
-            for X, meth in ((M, "mass_matrix"), (C, "damping_matrix"), (K, "stiffness_matrix"),
-                            (G, "gyroscopic_matrix")):
+            for meth, part in parts.items():
                 loc = getattr(el, meth)(p, self.layout)
                 if loc is not None:
-                    _sx_add(X, idx, loc, el.name, meth.split("_")[0])
+                    part.add(idx, loc, el.name, meth.split("_")[0])
+        M, C, K, G = (part.matrix() for part in parts.values())
         if isinstance(damping, ProportionalDamping):
             C = C + p[self._ps_name(damping.alpha, "alpha")] * M + p[self._ps_name(damping.beta, "beta")] * K
 
@@ -378,7 +415,7 @@ class Structure:
             vector in the order of ``parameters`` (default: nominal, see :meth:`Structure.values`).
         """
         out = self._all(self.values(values))
-        return tuple(np.asarray(x.full()) for x in out)
+        return tuple(_dense(x) for x in out)
 
     def matrices(self, values=None) -> Matrices:
         """Numeric ``Matrices(M, C, K, G)`` [SI] at ``values`` (default: nominal).

@@ -19,6 +19,7 @@ References
 """
 from __future__ import annotations
 
+import functools
 import math
 
 import casadi as ca
@@ -159,6 +160,15 @@ def timoshenko_plane_matrices(E, G, rho, L, do, di, kappa, shear=True):
     return Mt, Mr, K
 
 
+@functools.lru_cache(maxsize=None)
+def _timoshenko_function(shear: bool) -> ca.Function:
+    """:func:`timoshenko_plane_matrices` as one CasADi function of ``(E, G, rho, L, do, di, kappa)``:
+    called on an element's symbols it copies the expression graph in compiled code, where building
+    the expressions again in Python for each element took most of a rotor's assembly time."""
+    args = [ca.SX.sym(n) for n in ("E", "G", "rho", "L", "do", "di", "kappa")]
+    return ca.Function("timoshenko_plane", args, list(timoshenko_plane_matrices(*args, shear=shear)))
+
+
 def timoshenko_shape_functions(xi, L, phi):
     r"""Interdependent Timoshenko shape functions at :math:`\xi = z/L \in [0, 1]`.
 
@@ -296,6 +306,7 @@ class ShaftElement(Element):
                          kappa=kappa)
         self.shear = bool(shear)
         self.rotary_inertia = bool(rotary_inertia)
+        self._plane = None
         _positive(self, "L", "do", "E", "rho", "G", "kappa")
         _positive(self, "di", allow_zero=True)
         if self.nominal("di") >= self.nominal("do"):
@@ -303,6 +314,13 @@ class ShaftElement(Element):
                              f"the outer diameter {self.nominal('do'):g} m")
         if nu is not None and not -1.0 < self.nominal("nu") < 0.5:
             raise ModelError(f"{self.name}.nu must be in (-1, 0.5), got {self.nominal('nu'):g}")
+
+    def __getstate__(self):
+        # the symbolic matrices of the last assembly are not part of the element (copies and pickles
+        # rebuild them)
+        state = dict(self.__dict__)
+        state["_plane"] = None
+        return state
 
     def plane_matrices(self, p):
         """``(Mt, Mr, K)`` of :func:`timoshenko_plane_matrices` for this element.
@@ -312,6 +330,9 @@ class ShaftElement(Element):
         p : mapping of str to casadi.SX
             Parameter name -> symbol.
         """
+        # the mass, stiffness and gyroscopic matrices all start from these: built once per assembly
+        if self._plane is not None and self._plane[0] is p:
+            return self._plane[1]
         E, rho, L = self.sym(p, "E"), self.sym(p, "rho"), self.sym(p, "L")
         do, di = self.sym(p, "do"), self.sym(p, "di")
         if self.has("G"):
@@ -321,7 +342,8 @@ class ShaftElement(Element):
             nu = self.sym(p, "nu")
             G = E / (2.0 * (1.0 + nu))
         kappa = self.sym(p, "kappa") if self.has("kappa") else cowper_shear_coefficient(nu, do, di)
-        return timoshenko_plane_matrices(E, G, rho, L, do, di, kappa, shear=self.shear)
+        self._plane = (p, tuple(_timoshenko_function(self.shear)(E, G, rho, L, do, di, kappa)))
+        return self._plane[1]
 
     def mass_matrix(self, p, layout):
         Mt, Mr, _ = self.plane_matrices(p)
