@@ -209,10 +209,7 @@ class UncertainModel:
         delta : (n_params,) array_like
             Normalised perturbations, one per parameter in the order of ``params``.
         """
-        delta = np.asarray(delta, dtype=float).ravel()
-        if delta.size != len(self.params):
-            raise ModelError(f"expected {len(self.params)} perturbations, got {delta.size}")
-        return {p.name: p.value(d) for p, d in zip(self.params, delta)}
+        return {p.name: p.value(d) for p, d in zip(self.params, self._deltas(delta))}
 
     def delta_matrix(self, delta) -> np.ndarray:
         r""":math:`\Delta = \operatorname{diag}(\delta_i I_{r_i})` for normalised perturbations.
@@ -222,10 +219,14 @@ class UncertainModel:
         delta : (n_params,) array_like
             Normalised perturbations, one per parameter in the order of ``params``.
         """
+        return np.diag(np.repeat(self._deltas(delta), self.repetitions))
+
+    def _deltas(self, delta) -> np.ndarray:
+        """``delta`` as a flat float array of one perturbation per parameter, or a ModelError."""
         delta = np.asarray(delta, dtype=float).ravel()
         if delta.size != len(self.params):
             raise ModelError(f"expected {len(self.params)} perturbations, got {delta.size}")
-        return np.diag(np.repeat(delta, self.repetitions))
+        return delta
 
     def delta_vector(self, Delta, tol: float = 1e-9) -> np.ndarray:
         r"""Normalised perturbations :math:`\delta_i` of a structured ``Delta``, e.g. the
