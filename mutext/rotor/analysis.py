@@ -210,15 +210,33 @@ def _values(model, values):
     return v
 
 
+def _finite_number(value, what: str, unit: str) -> float:
+    """``value`` as a finite float, or a ModelError saying that ``what`` must be a number, or finite
+    (in ``unit``)."""
+    try:
+        x = float(value)
+    except (TypeError, ValueError):
+        raise ModelError(f"{what} must be a number ({unit}), got {value!r}") from None
+    if not np.isfinite(x):
+        raise ModelError(f"{what} must be finite ({unit}), got {x!r}")
+    return x
+
+
+def _speed_array(speeds, name: str) -> np.ndarray:
+    """``speeds`` [rad/s] as a non-empty 1-D array of finite floats, or a ModelError naming the model."""
+    try:
+        s = np.atleast_1d(np.asarray(speeds, dtype=float))
+    except (TypeError, ValueError):
+        raise ModelError(f"{name}: speeds must be numbers (rad/s), got {speeds!r}") from None
+    if s.ndim != 1 or s.size == 0 or not np.all(np.isfinite(s)):
+        raise ModelError(f"{name}: speeds must be a non-empty 1-D array of finite numbers (rad/s)")
+    return s
+
+
 def _speed(model, speed):
     if speed is None:
         return float(getattr(model, "speed", 0.0))
-    try:
-        speed = float(speed)
-    except (TypeError, ValueError):
-        raise ModelError(f"{model.name}: speed must be a number (rad/s), got {speed!r}") from None
-    if not np.isfinite(speed):
-        raise ModelError(f"{model.name}: speed must be finite (rad/s), got {speed!r}")
+    speed = _finite_number(speed, f"{model.name}: speed", "rad/s")
     if speed != 0.0 and getattr(model.layout, "kind", "") != "rotor":
         raise ModelError(f"{model.name}: a nonzero speed needs a two-plane rotor model (planes=2)")
     return speed
@@ -415,12 +433,7 @@ def campbell(model, speeds: Sequence[float], *, n: int = 6, values=None) -> Camp
         Parameter values: a mapping ``name -> value`` (SI) overriding nominal ones, or a full
         vector in the order of ``parameters`` (default: nominal, see :meth:`Structure.values`).
     """
-    try:
-        speeds = np.atleast_1d(np.asarray(speeds, dtype=float))
-    except (TypeError, ValueError):
-        raise ModelError(f"{model.name}: speeds must be numbers (rad/s), got {speeds!r}") from None
-    if speeds.ndim != 1 or speeds.size == 0 or not np.all(np.isfinite(speeds)):
-        raise ModelError(f"{model.name}: speeds must be a non-empty 1-D array of finite numbers (rad/s)")
+    speeds = _speed_array(speeds, model.name)
     n = _check_n(n)
     values = _values(model, values)
     with blas_single_thread():

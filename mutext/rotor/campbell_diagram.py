@@ -50,7 +50,7 @@ import numpy as np
 
 from ..errors import ModelError
 from ..lti import blas_single_thread
-from .analysis import _check_n, _values, modes, whirl_label
+from .analysis import _check_n, _speed_array, _values, modes, whirl_label
 from .sparse_modal import sparse_modes
 
 __all__ = ["CampbellDiagram", "Crossing", "campbell", "log_decrement", "whirl_labels", "speed_grid"]
@@ -201,12 +201,7 @@ def speed_grid(speeds, name="model") -> np.ndarray:
     name : str, optional
         Name of the model in the error message.
     """
-    try:
-        s = np.atleast_1d(np.asarray(speeds, dtype=float))
-    except (TypeError, ValueError):
-        raise ModelError(f"{name}: speeds must be numbers (rad/s), got {speeds!r}") from None
-    if s.ndim != 1 or s.size == 0 or not np.all(np.isfinite(s)):
-        raise ModelError(f"{name}: speeds must be a non-empty 1-D array of finite numbers (rad/s)")
+    s = _speed_array(speeds, name)
     if np.any(s < 0) or np.any(np.diff(s) <= 0):
         raise ModelError(f"{name}: speeds must be non-negative and strictly increasing (rad/s), got "
                          f"{s[:5].tolist()}{'...' if s.size > 5 else ''}")

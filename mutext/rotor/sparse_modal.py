@@ -17,7 +17,7 @@ import numpy as np
 
 from ..errors import ModelError
 from ..lti import blas_single_thread
-from .analysis import Modes, _check_n, _speed, _values, whirl_index
+from .analysis import Modes, _check_n, _finite_number, _speed, _values, whirl_index
 
 __all__ = ["sparse_modes"]
 
@@ -68,12 +68,7 @@ def sparse_modes(model, speed: float | None = None, n: int = 6, *, values=None, 
 
     n = _check_n(n)
     om = _speed(model, speed)
-    try:
-        shift = float(shift_hz)
-    except (TypeError, ValueError):
-        raise ModelError(f"{model.name}: shift_hz must be a number (Hz), got {shift_hz!r}") from None
-    if not np.isfinite(shift):
-        raise ModelError(f"{model.name}: shift_hz must be finite (Hz), got {shift_hz!r}")
+    shift = _finite_number(shift_hz, f"{model.name}: shift_hz", "Hz")
     v = _values(model, values)
     with blas_single_thread():
         M, C, K, G = model.matrices(v)

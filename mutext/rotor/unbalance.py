@@ -50,7 +50,7 @@ import numpy as np
 from .._validation import Integer, check_param
 from ..errors import ModelError
 from ..lti import blas_single_thread
-from .analysis import _values
+from .analysis import _finite_number, _values
 from .campbell_diagram import speed_grid
 from .orbits import Orbit, ellipse, orbit
 
@@ -76,12 +76,7 @@ def parse_probes(model, probes) -> list[tuple[int, float]]:
     for p in probes:
         st, ang = (p, 0.0) if not isinstance(p, (tuple, list)) else tuple(p) if len(p) == 2 else (None, None)
         check_param(f"{model.name}: probe {p!r}", "the station", st, Integer(1, model.layout.n_nodes))
-        try:
-            ang = float(ang)
-        except (TypeError, ValueError):
-            raise ModelError(f"{model.name}: probe {p!r}: the angle must be a number (rad from x)") from None
-        if not np.isfinite(ang):
-            raise ModelError(f"{model.name}: probe {p!r}: the angle must be finite (rad from x)")
+        ang = _finite_number(ang, f"{model.name}: probe {p!r}: the angle", "rad from x")
         out.append((int(st), ang))
     if not out:
         raise ModelError(f"{model.name}: needs at least one probe")
