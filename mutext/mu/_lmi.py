@@ -11,7 +11,7 @@ import numpy as np
 from .._solver import solve
 from ..errors import SolverError
 from ._certificate import MuUpper, _d_from_matrices, _diag_result, _gevp
-from ._structure import BlockStructure
+from ._structure import BlockStructure, _per_structure
 
 
 def _herm_basis(n: int):
@@ -169,16 +169,11 @@ _LMI_CACHE: dict = {}
 
 
 def _lmi_problem(S: BlockStructure, use_g: bool) -> _LMIProblem:
-    key = (S.blocks, use_g)
-    if key not in _LMI_CACHE:
-        if len(_LMI_CACHE) > 32:
-            _LMI_CACHE.clear()
-        try:
-            _LMI_CACHE[key] = _LMIProblem(S, use_g)
-        except ImportError as exc:
-            raise SolverError(f"the LMI upper bound needs cvxpy and Clarabel ({exc}); "
-                              "use method='osborne'") from None
-    return _LMI_CACHE[key]
+    try:
+        return _per_structure(_LMI_CACHE, 32, S, use_g, _LMIProblem)
+    except ImportError as exc:
+        raise SolverError(f"the LMI upper bound needs cvxpy and Clarabel ({exc}); "
+                          "use method='osborne'") from None
 
 
 def _easy_lower(M, S: BlockStructure) -> float:

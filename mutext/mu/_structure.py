@@ -359,6 +359,17 @@ def _as_structure(structure, what: str = "structure") -> "BlockStructure":
                          f"blk spec like [[1, 1], [-1, 0]] ({exc})") from None
 
 
+def _per_structure(cache: dict, limit: int, S: BlockStructure, use_g: bool, build):
+    """``build(S, use_g)``, kept in ``cache`` by the structure's blocks and ``use_g`` (emptied when it
+    holds more than ``limit``): the work that depends on the structure only, done once per structure."""
+    key = (S.blocks, use_g)
+    if key not in cache:
+        if len(cache) > limit:
+            cache.clear()
+        cache[key] = build(S, use_g)
+    return cache[key]
+
+
 def _norm2(M) -> float:
     """Largest singular value, computed on a scaled copy so that entries near the
     overflow or underflow limits do not break the SVD (inf if it overflows)."""

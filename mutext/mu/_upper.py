@@ -10,7 +10,7 @@ from ._certificate import MuUpper, _diag_result, _gevp
 from ._fast import _DGParams, _fast_default, _fast_polish
 from ._lmi import _lmi_bisect
 from ._osborne import _upper_osborne
-from ._structure import BlockStructure, _as_structure, _norm2
+from ._structure import BlockStructure, _as_structure, _norm2, _per_structure
 
 
 #: relative agreement required between a fast bound and its certificate recomputed from the
@@ -24,12 +24,7 @@ _PARAMS_CACHE: dict = {}
 
 
 def _params(S: BlockStructure, use_g: bool) -> _DGParams:
-    key = (S.blocks, use_g)
-    if key not in _PARAMS_CACHE:
-        if len(_PARAMS_CACHE) > 64:
-            _PARAMS_CACHE.clear()
-        _PARAMS_CACHE[key] = _DGParams(S, use_g)
-    return _PARAMS_CACHE[key]
+    return _per_structure(_PARAMS_CACHE, 64, S, use_g, _DGParams)
 
 
 def _lmi_needed(S: BlockStructure, use_g: bool) -> bool:
