@@ -66,6 +66,20 @@ def extended_model_text(model_text: str, finding: Finding, model) -> str:
     return header + mf.text()
 
 
+def _write_model_text(out_dir, text: str, confirmed: bool, unconfirmed_name: str, header) -> str:
+    """Write an extended model's ``text`` into ``out_dir``: as ``model_extended.toml`` when it is a
+    confirmed fix, otherwise as ``unconfirmed_name`` with ``header()`` (why not) in its first lines, so
+    that the file says in its name and its text that it is not a fix.  Returns the path written."""
+    if confirmed:
+        out = os.path.join(out_dir, "model_extended.toml")
+    else:
+        out = os.path.join(out_dir, unconfirmed_name)
+        text = header() + text
+    with open(out, "w", encoding="utf-8") as fh:
+        fh.write(text)
+    return out
+
+
 def write_model(result: Diagnosis, out_dir) -> str | None:
     """Write the extended model to ``out_dir/model_extended.toml`` (copying a station table it names).
 
@@ -102,15 +116,9 @@ def write_model(result: Diagnosis, out_dir) -> str | None:
         if os.path.abspath(src) != os.path.abspath(dst):
             shutil.copyfile(src, dst)
         text = text.replace(f'"{table}"', f'"{os.path.basename(table)}"')
-    if result.confirmed:
-        out = os.path.join(out_dir, "model_extended.toml")
-    else:
-        # not a fix: the file says so in its name and its first lines
-        out = os.path.join(out_dir, "model_extended_NOT_CONFIRMED.toml")
-        text = (f"# NOT A CONFIRMED FIX. Diagnosis status: {result.status}; held-out gain {result.gain:.3g}x.\n"
-                f"# {result.headline()}\n" + text)
-    with open(out, "w", encoding="utf-8") as fh:
-        fh.write(text)
+    out = _write_model_text(out_dir, text, result.confirmed, "model_extended_NOT_CONFIRMED.toml", lambda: (
+        f"# NOT A CONFIRMED FIX. Diagnosis status: {result.status}; held-out gain {result.gain:.3g}x.\n"
+        f"# {result.headline()}\n"))
     result.extended_model = out
     write_mbi_model(result, out_dir)
     return out
@@ -554,13 +562,9 @@ def write_mbi_model(result: Diagnosis, out_dir) -> str | None:
     if not text:
         return None
     os.makedirs(out_dir, exist_ok=True)
-    if m["status"] == "explained" and not result.confirmed:
-        out = os.path.join(out_dir, "model_extended.toml")
-    else:
-        out = os.path.join(out_dir, "model_extended_mbi_NOT_CONFIRMED.toml")
-        text = (f"# NOT A CONFIRMED FIX. Model-based identification element: {m['status']}; held-out gain "
-                f"{m['held_out_gain']:.3g}x.\n" + text)
-    with open(out, "w", encoding="utf-8") as fh:
-        fh.write(text)
+    out = _write_model_text(out_dir, text, m["status"] == "explained" and not result.confirmed,
+                            "model_extended_mbi_NOT_CONFIRMED.toml", lambda: (
+                                f"# NOT A CONFIRMED FIX. Model-based identification element: {m['status']}; "
+                                f"held-out gain {m['held_out_gain']:.3g}x.\n"))
     m["extended_model"] = out
     return out
