@@ -97,6 +97,13 @@ def _weighting(G: ct.StateSpace, nunc: int, p: TwoMass) -> ct.StateSpace:
               outputs=zn + ["z1", "z2", "y"])
 
 
+def _uncertain_at(x_max: float, rel: float, p: TwoMass | None) -> tuple[TwoMass, UncertainModel]:
+    """The parameters ``p`` (default: the thesis's) with the allowed displacement ``x_max``, and their
+    uncertain model with the relative half-width ``rel``."""
+    p = TwoMass(x_max=x_max) if p is None else p.with_(x_max=x_max)
+    return p, uncertain_model(p, rel)
+
+
 def plant(x_max: float = 0.035, rel: float = 0.02, p: TwoMass | None = None) -> ct.StateSpace:
     """Generalized plant for robust performance (use with ``nmeas=1, ncon=1``).
 
@@ -113,8 +120,7 @@ def plant(x_max: float = 0.035, rel: float = 0.02, p: TwoMass | None = None) -> 
     p : TwoMass, optional
         The other parameters (default: the thesis's).
     """
-    p = TwoMass(x_max=x_max) if p is None else p.with_(x_max=x_max)
-    U = uncertain_model(p, rel)
+    p, U = _uncertain_at(x_max, rel, p)
     return _weighting(U.P, U.nunc, p)
 
 
@@ -140,8 +146,7 @@ def plant_at(delta, x_max: float = 0.035, rel: float = 0.02, p: TwoMass | None =
     p : TwoMass, optional
         The other parameters (default: the thesis's).
     """
-    p = TwoMass(x_max=x_max) if p is None else p.with_(x_max=x_max)
-    U = uncertain_model(p, rel)
+    p, U = _uncertain_at(x_max, rel, p)
     G = U.at(U.values(delta))
     return _weighting(G, 0, p)
 
