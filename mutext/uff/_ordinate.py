@@ -84,22 +84,21 @@ def _spec_types(path, n, d) -> tuple:
 
 def _label_units(path, n, raw_num, raw_den, num_lab, den_lab, example) -> tuple:
     """The ordinate's and the denominator's units labels read (:class:`Units`, None where not given)."""
-    num = den = None
-    if _label_used(num_lab):
-        try:
-            num = motion_units(num_lab)
-        except ValueError as exc:
-            raise _err(path, n, "ordinate_axis_units_lab",
-                       f"unknown unit {str(raw_num).strip()!r} ({exc}); known: {KNOWN_UNITS}; "
-                       f"{units_hint(raw_num, example)}") from None
-    if _label_used(den_lab):
-        try:
-            den = reference_units(den_lab)
-        except ValueError as exc:
-            raise _err(path, n, "orddenom_axis_units_lab",
-                       f"unknown unit {str(raw_den).strip()!r} ({exc}); known: N, kN, lbf, lb (force), A, mA "
-                       f"(current); {units_hint(raw_den, 'N')}") from None
-    return num, den
+    return (_label(path, n, "ordinate_axis_units_lab", raw_num, num_lab, motion_units, KNOWN_UNITS, example),
+            _label(path, n, "orddenom_axis_units_lab", raw_den, den_lab, reference_units,
+                   "N, kN, lbf, lb (force), A, mA (current)", "N"))
+
+
+def _label(path, n, key: str, raw, label, read, known: str, example: str):
+    """One units label (``raw`` as in the file, ``label`` as it is read) read by ``read``; None where it is
+    not given, an error naming ``key``, the ``known`` units and a hint with ``example`` where it is unknown."""
+    if not _label_used(label):
+        return None
+    try:
+        return read(label)
+    except ValueError as exc:
+        raise _err(path, n, key, f"unknown unit {str(raw).strip()!r} ({exc}); known: {known}; "
+                                 f"{units_hint(raw, example)}") from None
 
 
 def _from_labels(path, n, num, den, raw_num, raw_den) -> tuple:
