@@ -21,7 +21,9 @@ Model (Friswell, Penny, Garvey and Lees, *Dynamics of Rotating Machines*, CUP 20
 * Table rows with added mass / inertias: rigid lumped disks, :math:`\mathrm{diag}(m, m, I_d,
   I_d)` and the gyroscopic pair :math:`\pm I_p` on the two rotations.
 * Bearings: isotropic springs to ground (the ``[[bearing]]`` tables: stations 2 and 29,
-  1e7 N/m, no damping).
+  1e7 N/m, no damping); a hidden ``("cross", s, ...)`` effect adds cross-coupled stiffness to
+  the bearing block on (u, v): ``K[u, v] += kxy``, ``K[v, u] += kyx`` (the bearing's force on
+  the shaft is ``-K q``).
 * Exciter: force per ampere (40 N/A) at station 12 in x; no negative stiffness.
 * Damping: 1 % modal, :math:`C = M\Phi\,\mathrm{diag}(2\zeta\omega_r)\Phi^T M` with
   :math:`\Phi^T M \Phi = I` the undamped modes of :math:`(K, M)` at zero speed (all DOFs
@@ -174,7 +176,10 @@ def plain_rotor(extra=None, *, n_sub=1, path=MODEL_FILE) -> PlainRotor:
         ``("spring", s, k)``: isotropic grounded spring k [N/m] at station s;
         ``("mass", s, m)``: point mass m [kg] (translation only) at station s;
         ``("bearing", s, dk)``: the stiffness of the bearing at station s changed by dk [N/m]
-        (both directions).  Modal damping is computed from M and K *with* the effects.
+        (both directions); ``("cross", s, q)``: cross-coupled stiffness in the bearing at station s,
+        skew ``kxy = q``, ``kyx = -q`` [N/m] (or ``("cross", s, (kxy, kyx))``).  Modal damping is
+        computed from M and K *with* the effects (from the symmetric part of K, which a skew
+        cross-coupling leaves unchanged).
     n_sub : int
         Sub-elements per table element (1: the package's mesh).
     """
@@ -242,19 +247,32 @@ def plain_rotor(extra=None, *, n_sub=1, path=MODEL_FILE) -> PlainRotor:
                 raise ValueError(f"no bearing at station {s}")
             for d in dofs:
                 K[d, d] += size
+        elif kind == "cross":
+            if s not in num["bearings"]:
+                raise ValueError(f"no bearing at station {s}")
+            kxy, kyx = (size, -size) if np.ndim(size) == 0 else size
+            u, v = dofs
+            K[u, v] += kxy
+            K[v, u] += kyx
         else:
             raise ValueError(f"unknown effect kind {kind!r}")
     rot.C = C0 + modal_damping(M, K, num["zeta"])
     return rot
 
 
-def plain_frf(freq_hz, out_station, direction="x", extra=None, *, n_sub=1, rotor=None):
-    """Response [m/A] from the exciter current to the displacement of ``out_station`` in x or y."""
+def plain_frf(freq_hz, out_station, direction="x", extra=None, *, n_sub=1, rotor=None, force_at=None):
+    """Response [m/A] from the exciter current to the displacement of ``out_station`` in x or y.
+
+    ``force_at = (station, "x" or "y")``: the response [m/N] to a unit force there instead."""
     r = plain_rotor(extra, n_sub=n_sub) if rotor is None else rotor
     w = 2.0 * np.pi * np.asarray(freq_hz, dtype=float)
     D = r.C + r.speed * r.G
     Z = r.K[None] - (w ** 2)[:, None, None] * r.M[None] + 1j * w[:, None, None] * D[None]
-    X = np.linalg.solve(Z, np.broadcast_to(r.b[:, None], (w.size, r.ndof, 1)))[:, :, 0]
+    b = r.b
+    if force_at is not None:
+        b = np.zeros(r.ndof)
+        b[r.dof(force_at[0], "u" if force_at[1] == "x" else "v")] = 1.0
+    X = np.linalg.solve(Z, np.broadcast_to(b[:, None], (w.size, r.ndof, 1)))[:, :, 0]
     return X[:, r.dof(out_station, "u" if direction == "x" else "v")]
 
 

@@ -32,7 +32,7 @@ _DISK = {"station": None, "name": None, "mass": "mass", "polar_inertia": "inerti
          "transverse_inertia": "inertia", "width": "length", "outer_diameter": "length",
          "inner_diameter": "length", "density": "density"}
 _BEARING = {"station": None, "name": None, "stiffness": "stiffness", "damping": "damping",
-            "stiffness_y": "stiffness", "damping_y": "damping"}
+            "stiffness_y": "stiffness", "damping_y": "damping", "kxy": "stiffness", "kyx": "stiffness"}
 _EXCITER = {"station": None, "name": None, "direction": None, "force_per_ampere": "force_per_current",
             "negative_stiffness": "stiffness"}
 _PORT_ROTOR = {"station": None, "name": None, "direction": None}

@@ -139,7 +139,7 @@ def _load_rotor(ctx: _Ctx, doc: dict, base_dir: str, station_table=None) -> Roto
     planes, speed = _planes_and_speed(ctx, doc)
 
     extra = _disks(ctx, doc, n)
-    extra += _bearings(ctx, doc, n)
+    extra += _bearings(ctx, doc, n, planes)
     extra += _exciters(ctx, doc, n, planes)
     ins, outs = _rotor_ports(ctx, doc, n, planes)
     auto = _cracks(ctx, doc, n, extra)
@@ -252,8 +252,8 @@ def _disks(ctx: _Ctx, doc: dict, n: int) -> list:
     return extra
 
 
-def _bearings(ctx: _Ctx, doc: dict, n: int) -> list:
-    """The ``[[bearing]]`` tables."""
+def _bearings(ctx: _Ctx, doc: dict, n: int, planes: int = 2) -> list:
+    """The ``[[bearing]]`` tables (cross-coupled stiffness ``kxy``, ``kyx``, either sign: two planes only)."""
     extra = []
     for k, t in enumerate(_array_of_tables(ctx, doc, "bearing"), start=1):
         where = f"[[bearing]] #{k}"
@@ -264,6 +264,12 @@ def _bearings(ctx: _Ctx, doc: dict, n: int) -> list:
             kw["kyy"] = ctx.number(t, "stiffness_y", "stiffness", where)
         if "damping_y" in t:
             kw["cyy"] = ctx.number(t, "damping_y", "damping", where)
+        for key in ("kxy", "kyx"):
+            if key in t:
+                kw[key] = ctx.number(t, key, "stiffness", where, nonneg=False)
+                if planes != 2:
+                    raise ctx.err(f"{where}, {key}", "cross-coupled stiffness needs both bending planes "
+                                                     f"(planes = 2), the file has planes = {planes}")
         extra.append(BearingElement(s, ctx.number(t, "stiffness", "stiffness", where),
                                     ctx.number(t, "damping", "damping", where, default=0.0),
                                     name=ctx.string(t, "name", where) or f"bearing{s}", **kw))

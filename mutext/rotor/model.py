@@ -45,6 +45,10 @@ Rotor files
     station = 2
     stiffness = 1.0e7             # N/m; stiffness_y for anisotropic bearings
     damping = 0.0                 # N s/m; damping_y
+    kxy = 0.0                     # N/m, optional, either sign: cross-coupled stiffness, force in x
+    kyx = 0.0                     #   per displacement in y (kyx: y per x); planes = 2 only.  The
+                                  #   bearing's force is f = -K (u, v), K = [[k, kxy], [kyx, k_y]];
+                                  #   kxy = -kyx = q > 0 (seals, fluid films) drives forward whirl
 
     [[exciter]]
     station = 12
@@ -142,8 +146,8 @@ The parameter of a lumped element is called by the element's name (``"m1"``,
 ``"k1"``, ``"c1"``).  In rotors: ``"E"`` and ``"rho"`` (one each when all
 shaft elements share the value, else ``"shaft<s>.E"``), ``"nu"`` or ``"G"``,
 ``"shaft<s>.L"``, ``".do"``, ``".di"``, ``"disk<s>.m"``, ``".Ip"``, ``".Id"``,
-``"bearing<s>.k"``, ``".c"``, ``"exciter<s>.ki"``, ``".kx"``; proportional damping:
-``"damping.alpha"``, ``"damping.beta"``.
+``"bearing<s>.k"``, ``".c"`` (``".kyy"``, ``".cyy"``, ``".kxy"``, ``".kyx"`` when given),
+``"exciter<s>.ki"``, ``".kx"``; proportional damping: ``"damping.alpha"``, ``"damping.beta"``.
 
 Errors name the file, the table (``[[bearing]] #2``) and key, and the problem.
 """
