@@ -442,6 +442,48 @@ def test_sparse_modes_against_plain_rotor():
     assert lam[1].imag == pytest.approx(2 * two.speed, rel=1e-8)
 
 
+def _fine_shaft(n_el, free=False):
+    """A 1.5 m, 50 mm steel shaft of ``n_el`` Timoshenko elements with a disk, on two bearings
+    (none when ``free``), spring-supported and lightly damped there."""
+    from mutext.rotor import BearingElement, DiskElement, Rotor, ShaftElement
+    els = [ShaftElement(i, 1.5 / n_el, 0.05, 0.0, E=211e9, rho=7810.0, nu=0.3) for i in range(1, n_el + 1)]
+    els.append(DiskElement.from_geometry(n_el // 3 + 1, 0.07, 0.28, 0.05, 7810.0))
+    if not free:
+        els += [BearingElement(1, 1e6, 100.0), BearingElement(n_el + 1, 1e6, 100.0)]
+    return Rotor(els)
+
+
+@pytest.mark.slow
+def test_modes_take_the_sparse_route_on_a_fine_mesh_with_the_dense_modes():
+    # (8 CPU-s: two dense eigen-decompositions of 808 states; the default run checks the sparse route's
+    # errors below and its modes against the plain rotor above)
+    # 100 elements, 404 DOFs: a few modes come from the shift-invert solve; the same frequencies as the
+    # dense eigen-decomposition, and each shape in the span of the dense shapes of its frequency
+    model = _fine_shaft(100)
+    W = rpm_to_rad_s(4000.0)
+    dense = model.modes(speed=W, n=4, method="dense")
+    auto = model.modes(speed=W, n=4)
+    np.testing.assert_allclose(auto.eigenvalues, dense.eigenvalues, rtol=1e-8)
+    for r in range(4):
+        Q = dense.shapes[:, np.abs(dense.omega - auto.omega[r]) < 1e-6 * auto.omega[r]]
+        x, *_ = np.linalg.lstsq(Q, auto.shapes[:, r], rcond=None)
+        assert np.linalg.norm(Q @ x - auto.shapes[:, r]) < 1e-6 * np.linalg.norm(auto.shapes[:, r])
+    sparse = model.modes(speed=W, n=4, method="sparse")
+    np.testing.assert_allclose(sparse.eigenvalues, auto.eigenvalues, rtol=1e-8)      # ARPACK starts at random
+    # a free-free shaft (rigid-body modes): "auto" falls back to the dense route, which leaves them out
+    assert _fine_shaft(100, free=True).modes(n=2).frequencies_hz[0] > 1.0
+
+
+def test_sparse_route_of_modes_says_what_it_needs():
+    free = _fine_shaft(100, free=True)
+    with pytest.raises(ModelError, match="rigid-body"):
+        free.modes(n=2, method="sparse")
+    with pytest.raises(ModelError, match="give n"):
+        free.modes(method="sparse")
+    with pytest.raises(ModelError, match="method must be"):
+        free.modes(n=2, method="arpack")
+
+
 def test_periodic_response_and_orbit_bad_input_is_named():
     from mutext.rotor.periodic_orbit import periodic_unbalance_response
     j = jeffcott(c=1.0)

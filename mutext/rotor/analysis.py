@@ -80,6 +80,7 @@ import scipy.linalg as sla
 from ..errors import IllPosedError, ModelError, MutextError
 from ..lti import blas_single_thread, mck_to_ss
 from ..response import FRFMatrix
+from ._shift_invert import shift_invert_roots
 
 __all__ = ["Modes", "Campbell", "modes", "natural_frequencies", "campbell", "frf",
            "state_space", "whirl_index", "blas_single_thread"]
@@ -243,7 +244,7 @@ def _speed(model, speed):
 
 
 def modes(model, *, speed: float | None = None, values=None, n: int | None = None,
-          rigid_tol: float = 1e-6, matrices=None) -> Modes:
+          rigid_tol: float = 1e-6, matrices=None, method: str = "auto") -> Modes:
     """Modes of ``model`` (a :class:`~mutext.rotor.assembly.Structure`) at ``speed`` [rad/s].
 
     Parameters
@@ -262,6 +263,16 @@ def modes(model, *, speed: float | None = None, values=None, n: int | None = Non
         (see the module docstring).  Overdamped roots are dropped too.
     matrices : Matrices, optional
         Precomputed ``model.matrices(values)``.
+    method : {"auto", "dense", "sparse"}
+        ``"dense"``: every root of the first-order system (:math:`O(n^3)`);
+        ``"sparse"``: the ``n`` lowest by shift-invert Arnoldi on the sparse pencil
+        (:mod:`mutext.rotor.sparse_modal`; needs ``n``, a nonsingular stiffness
+        matrix and raises if ARPACK does not converge); ``"auto"``: sparse
+        when it pays -- ``n`` given, at least 400 DOFs, ``2n + 8`` at most a tenth of
+        them, banded mass and damping matrices (not modal damping, which is dense)
+        and a positive definite stiffness matrix (no rigid-body mode) -- falling
+        back to dense if the sparse solve fails.  Both give the same modes (to
+        about 1e-10 in frequency; shapes normalised alike).
 
     Examples
     --------
@@ -276,10 +287,14 @@ def modes(model, *, speed: float | None = None, values=None, n: int | None = Non
     _no_impedance(model, "modes")
     if not (isinstance(rigid_tol, (int, float, np.integer, np.floating)) and 0 <= rigid_tol < 1):
         raise ModelError(f"rigid_tol must lie in [0, 1), got {rigid_tol!r}")
+    if method not in ("auto", "dense", "sparse"):
+        raise ModelError(f"method must be 'auto', 'dense' or 'sparse', got {method!r}")
+    if method == "sparse" and n is None:
+        raise ModelError("method='sparse' finds the n lowest modes: give n")
     if matrices is None:
         values = _values(model, values)
     with blas_single_thread():
-        return _modes(model, _speed(model, speed), values, n, rigid_tol, matrices)
+        return _modes(model, _speed(model, speed), values, n, rigid_tol, matrices, method)
 
 
 def _no_impedance(model, what: str) -> None:
@@ -292,9 +307,17 @@ def _no_impedance(model, what: str) -> None:
                          "state_space(model).poles() or frf(model, ...)")
 
 
-def _modes(model, speed, values, n, rigid_tol, matrices) -> Modes:
+def _modes(model, speed, values, n, rigid_tol, matrices, method="dense") -> Modes:
     M, C, K, G = model.matrices(values) if matrices is None else matrices
     D = C + speed * G
+    if method == "sparse" or (method == "auto" and n is not None and _sparse_pays(M, D, K, n)):
+        try:
+            ev, shapes = shift_invert_roots(M, K, D, n, 0.0, 8, model.name)
+        except ModelError:
+            if method == "sparse":
+                raise
+        else:
+            return _as_modes(model, ev, shapes, speed)
     ndof = M.shape[0]
     try:
         np.linalg.cholesky(M)
@@ -319,10 +342,8 @@ def _modes(model, speed, values, n, rigid_tol, matrices) -> Modes:
         if lam.min() < -rigid_tol**2 * scale:
             raise IllPosedError(_divergence(model, np.sqrt(-lam[lam < -rigid_tol**2 * scale])))
         keep = lam > rigid_tol**2 * scale
-        w = np.sqrt(lam[keep])
-        ev = 1j * w
+        ev = 1j * np.sqrt(lam[keep])
         shapes = Phi[:, keep].astype(complex)
-        zeta = np.zeros_like(w)
     else:
         try:
             with np.errstate(over="ignore", invalid="ignore"):
@@ -333,16 +354,46 @@ def _modes(model, speed, values, n, rigid_tol, matrices) -> Modes:
             raise ModelError(overflow) from None
         if not np.all(np.isfinite(ev)):
             raise ModelError(overflow)
-        w = ev.imag
-        zeta = -ev.real / np.abs(ev)
     if n is not None:
-        ev, w, zeta, shapes = ev[:n], w[:n], zeta[:n], shapes[:, :n]
+        ev, shapes = ev[:n], shapes[:, :n]
+    return _as_modes(model, ev, shapes, speed)
+
+
+def _as_modes(model, ev, shapes, speed) -> Modes:
+    """:class:`Modes` of the roots ``ev`` (Im > 0, sorted) and their shapes, each scaled to 1 at its largest
+    entry."""
+    shapes = np.array(shapes, dtype=complex)
     for r in range(shapes.shape[1]):
         k = int(np.argmax(np.abs(shapes[:, r])))
         if shapes[k, r] != 0:
             shapes[:, r] = shapes[:, r] / shapes[k, r]
+    w = ev.imag
+    zeta = -ev.real / np.abs(ev) + 0.0          # + 0.0: an undamped mode's -0.0 is 0.0
     whirl = np.array([whirl_index(shapes[:, r], model.layout) for r in range(shapes.shape[1])])
     return Modes(ev, w, w / (2 * np.pi), zeta, shapes, whirl, speed, model.dof_names)
+
+
+def _sparse_pays(M, D, K, n: int) -> bool:
+    """Whether a shift-invert solve for ``n`` modes beats the dense one and is safe: see :func:`modes`."""
+    N = M.shape[0]
+    if N < 400 or 2 * n + 8 > N // 10:
+        return False
+    if np.count_nonzero(M) > 0.05 * N * N or np.count_nonzero(D) > 0.05 * N * N:
+        return False
+    # no rigid-body or statically unstable mode (the dense route names them): a banded Cholesky of K
+    Ks = 0.5 * K + 0.5 * K.T
+    r, c = np.nonzero(Ks)
+    b = int(np.max(np.abs(c - r))) if r.size else 0
+    if b > N // 10:
+        return False
+    ab = np.zeros((b + 1, N))
+    for d in range(b + 1):
+        ab[b - d, d:] = np.diagonal(Ks, d)
+    try:
+        sla.cholesky_banded(ab, check_finite=True)
+    except (np.linalg.LinAlgError, ValueError):
+        return False
+    return True
 
 
 def _damped_modes(M, D, K, Ks, rigid_tol, model):

@@ -15,8 +15,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..errors import ModelError
 from ..lti import blas_single_thread
+from ._shift_invert import shift_invert_roots
 from .analysis import Modes, _check_n, _finite_number, _speed, _values, whirl_index
 
 __all__ = ["sparse_modes"]
@@ -63,41 +63,13 @@ def sparse_modes(model, speed: float | None = None, n: int = 6, *, values=None, 
     mutext.rotor.analysis.Modes
         Sorted by frequency, at most ``n`` modes.
     """
-    import scipy.sparse as sp
-    from scipy.sparse.linalg import ArpackNoConvergence, eigs
-
     n = _check_n(n)
     om = _speed(model, speed)
     shift = _finite_number(shift_hz, f"{model.name}: shift_hz", "Hz")
     v = _values(model, values)
     with blas_single_thread():
         M, C, K, G = model.matrices(v)
-        N = M.shape[0]
-        k = min(2 * n + int(extra), 2 * N - 2)
-        Ms, Ks, Ds = (sp.csc_matrix(np.where(np.abs(X) > 0, X, 0.0)) for X in (M, K, C + om * G))
-        A = sp.bmat([[None, sp.identity(N)], [-Ks, -Ds]], format="csc")
-        B = sp.bmat([[sp.identity(N), None], [None, Ms]], format="csc")
-        sigma = 2j * np.pi * shift if shift else 0.0
-        try:
-            lam, X = eigs(A, k=k, M=B, sigma=sigma, which="LM")
-        except ArpackNoConvergence as exc:
-            raise ModelError(f"{model.name}: the shift-invert eigen-solve did not converge "
-                             f"({len(exc.eigenvalues)} of {k} eigenvalues); try another shift_hz") from None
-        except RuntimeError as exc:          # singular A - sigma B (a rigid-body mode at the shift)
-            raise ModelError(f"{model.name}: A - sigma B is singular at shift_hz = {shift:g} ({exc}); a model "
-                             "with rigid-body modes needs a nonzero shift_hz") from None
-    Q = X[:N]
-    keep = lam.imag > 0
-    lam, Q = lam[keep], Q[:, keep]
-    Dsym = 0.5 * (C + om * G + (C + om * G).T)
-    m = np.real(np.sum(np.conj(Q) * (M @ Q), axis=0))
-    kk = np.real(np.sum(np.conj(Q) * ((0.5 * (K + K.T)) @ Q), axis=0))
-    c = np.real(np.sum(np.conj(Q) * (Dsym @ Q), axis=0))
-    under = (c <= 0.0) | (c < 2.0 * np.sqrt(np.maximum(kk, 0.0) * m))
-    lam, Q = lam[under], Q[:, under]
-    near = np.argsort(np.abs(lam.imag - 2 * np.pi * shift))[:n]          # the n nearest the shift ...
-    order = near[np.argsort(lam[near].imag)]                              # ... by frequency
-    lam, Q = lam[order], Q[:, order]
+        lam, Q = shift_invert_roots(M, K, C + om * G, n, shift, extra, model.name)
     for r in range(Q.shape[1]):
         j = int(np.argmax(np.abs(Q[:, r])))
         Q[:, r] /= Q[j, r]
