@@ -8,9 +8,10 @@ bearings of 1 MN/m and 100 N s/m at the ends), the CPU times of
 * build: the model from its element data to numeric global matrices (mutext:
   elements, ``Rotor`` (the CasADi assembly) and one ``matrices()`` call; ROSS:
   elements and ``Rotor``, which assembles the matrices);
-* modal at 0 and at 4000 rpm, the lowest ``--modes`` modes: mutext's dense
-  ``Rotor.modes(speed=..., n=...)`` and sparse shift-invert
-  ``mutext.rotor.sparse_modal.sparse_modes`` against ROSS's
+* modal at 0 and at 4000 rpm, the lowest ``--modes`` modes: mutext's default
+  ``Rotor.modes(speed=..., n=...)`` (``method="auto"``: the dense eigen-decomposition,
+  or from 400 DOFs up the sparse shift-invert solve) and the sparse shift-invert
+  ``mutext.rotor.sparse_modal.sparse_modes`` always, against ROSS's
   ``rotor.run_modal(speed, num_modes=2 n)`` (which returns ``n`` modes);
 * FRF at 4000 rpm on ``--nfreq`` frequencies (2-200 Hz), force in x at the first
   disk to displacement in x at the second: ``mutext.rotor.analysis.frf`` against
@@ -35,7 +36,7 @@ thread on both sides (``threadpoolctl`` here; ``OMP_NUM_THREADS=1``,
 the ROSS process).  Imports and the interpreter start are not timed.  A sparse
 solve that ARPACK does not finish at shift 0 is repeated at other shifts within the
 timed run (counted in the output).  The default run takes some 5 CPU minutes,
-most of them ROSS's FRF and mutext's dense modes on 200 elements.
+most of them ROSS's FRF on 200 elements.
 
 ROSS 3.1 needs Python >= 3.13, so it runs in its own environment, in a
 subprocess (the script ``ROSS_SCRIPT`` below, JSON in and out)::
@@ -296,7 +297,7 @@ def main(argv=None) -> int:
     ver = ross["ross"] if ross else "not run"
     print(f"\nmutext.rotor against ROSS {ver}: median process CPU time [s] of {args.repeat} runs, one BLAS thread; "
           f"{args.modes} modes; FRF on {args.nfreq} frequencies at {SPEEDS_RPM[-1]:g} rpm")
-    cols = ["build", "modal 0 rpm", "modal 0 sparse", "modal 4000", "modal 4000 sp.", "FRF"]
+    cols = ["build", "modes() 0 rpm", "modal 0 sparse", "modes() 4000", "modal 4000 sp.", "FRF"]
     print(f"{'rotor':<13} {'':<14} {'DOFs':>5} " + " ".join(f"{c:>14}" for c in cols))
     worst_w, worst_h = 0.0, 0.0
     for k, a in enumerate(ours):
