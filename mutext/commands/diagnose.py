@@ -1,4 +1,4 @@
-"""``mutext diagnose MODEL.toml DATA.csv [...] [--validate VAL.csv ...] [--out DIR] [--json]``,
+"""``mutext diagnose MODEL.toml DATA.csv [...] [--validate VAL.csv ...] [--repeat REP.csv ...] [--out DIR] [--json]``,
 or ``mutext diagnose --batch DIR [--jobs N]`` for every data set under DIR."""
 from __future__ import annotations
 
@@ -20,6 +20,12 @@ def add_arguments(p):
     p.add_argument("--validate", nargs="+", default=[], metavar="FILE",
                    help="FRF files held out of the fit, on which the gain is measured (default: every 5th "
                         "frequency of the fitted files)")
+    p.add_argument("--repeat", nargs="+", default=[], metavar="FILE",
+                   help="the same channels measured again at another excitation level (force amplitude), on the "
+                        "same frequencies: compared with the measured files without a model, a chi-square test "
+                        "against the noise; a response that depends on the level (a nonlinear structure) is said "
+                        "first and no linear model is then called explained.  Not fitted.  A file's "
+                        "'# excitation: 2 N' header line is reported when present")
     p.add_argument("--out", metavar="DIR", help="write the extended model, report.html, figures and "
                                                 "diagnosis.json into DIR")
     p.add_argument("--json", action="store_true", help="print one JSON object instead of the report")
@@ -44,7 +50,7 @@ def _check_usage(args) -> None:
     """Usage mistakes, said before anything heavy is imported (exit code 2)."""
     from ..errors import UsageError
     if args.batch:
-        if args.model or args.data or args.validate or args.out:
+        if args.model or args.data or args.validate or args.repeat or args.out:
             raise UsageError("--batch takes a directory only (each data set holds its model and files)")
         return
     if args.jobs != 1 or args.scheduler:
@@ -116,7 +122,8 @@ def run(args) -> int:
         output_directory(args.out)        # checked before the work, not after it
     data = read_frfs(args.data)
     validate = read_frfs(args.validate) if args.validate else None
-    res = diagnose(args.model, data, validate=validate, alpha=args.alpha, noise=args.noise,
+    repeat = read_frfs(args.repeat) if args.repeat else None
+    res = diagnose(args.model, data, validate=validate, repeat=repeat, alpha=args.alpha, noise=args.noise,
                    progress=prog, mbi=args.mbi)
     if args.out:
         prog("writing the report", 1.0)

@@ -5,7 +5,7 @@ import logging
 import math
 import os
 import time
-from dataclasses import dataclass, replace
+from dataclasses import dataclass, field, replace
 from typing import Callable
 
 import numpy as np
@@ -25,6 +25,7 @@ from .faults import structure as _structure
 from ._result import ChannelComparison, Diagnosis, Finding
 from ._channels import _resolve, _src
 from ._fit_quality import fit_quality, noise_reference
+from ._amplitude import describe_levels, level_test, pair_channels, pair_noise
 from ._screen import _Data, _Evaluator, _Receptance, _fit_size, _fit_vector, _jacobian_std, _rss
 from ._decision import _decide, _finding, _in_model_file, _judge, _select_more, _status
 from ._select import Compound
@@ -51,8 +52,8 @@ def _same_data(a: FRF, b: FRF) -> bool:
             and np.array_equal(a.response, b.response))
 
 
-def diagnose(model, frfs, validate=None, *, alpha: float = 0.01, refit: int = 3, noise: float | None = None,
-             out_dir=None, progress: Callable[[str, float], None] | None = None,
+def diagnose(model, frfs, validate=None, *, repeat=None, alpha: float = 0.01, refit: int = 3,
+             noise: float | None = None, out_dir=None, progress: Callable[[str, float], None] | None = None,
              only: Callable[[Hypothesis], bool] | None = None, mbi: bool = False) -> Diagnosis:
     r"""Find what ``model`` gets wrong against measured FRFs, name the cause, extend the model, measure the gain.
 
@@ -70,6 +71,19 @@ def diagnose(model, frfs, validate=None, *, alpha: float = 0.01, refit: int = 3,
     validate : sequence of FRF or paths, optional
         Channels held out of the fit, on which the gain is measured.  Default:
         every :data:`HOLDOUT_EVERY`-th frequency of each fitted channel.
+    repeat : sequence of FRF or paths, optional
+        The same channels measured again at another excitation level (force
+        amplitude), on the same frequencies (those both hold are compared).
+        A nonlinear structure answers each level differently, which no
+        linear hypothesis can hold: each channel is compared with its
+        measured twin, without a model, a chi-square test at ``alpha`` against
+        both sets' noise (:mod:`mutext.diagnose._amplitude`).  When the levels
+        differ beyond the noise, the verdict says so first and the status is at
+        most *partly explained* (when the final model fits the lower-level
+        data; else *not explained*); otherwise a note says the repeat agreed.
+        The repeat is not fitted.  A file's excitation level (header key
+        ``excitation``, e.g. ``# excitation: 2 N``) is reported when given.
+        ``Diagnosis.amplitude`` holds the test.
     alpha : float
         False-alarm rate of the *none* verdict (Bonferroni over the hypotheses).
     refit : int
@@ -122,7 +136,7 @@ def diagnose(model, frfs, validate=None, *, alpha: float = 0.01, refit: int = 3,
     """
     with blas_single_thread():        # small dense problems: extra BLAS threads only spin on a busy machine
         try:
-            return _diagnose(model, frfs, validate, alpha, refit, noise, out_dir, progress, only, mbi)
+            return _diagnose(model, frfs, validate, alpha, refit, noise, out_dir, progress, only, mbi, repeat)
         finally:
             _EXTENDED.clear()
 
@@ -135,7 +149,9 @@ class _Reading:
     fitted and the validation channels; ``speed``: their running speed (rad/s); ``ref``: the noise
     reference, ``s2`` the noise variance of one real number; ``rec``: the engineering model's receptance on
     one grid for all; ``fit``, ``held``, ``all_fit``: the fitted, held-out and all fitted data sets;
-    ``held_desc``: what the held-out data are."""
+    ``held_desc``: what the held-out data are; ``pairs``: the channels repeated at another excitation
+    level with their measured twins (:func:`mutext.diagnose._amplitude.pair_channels`), ``rref`` the noise
+    of one sweep estimated from both (:func:`mutext.diagnose._amplitude.pair_noise`)."""
     path: str
     eng: object
     model_text: str
@@ -149,9 +165,11 @@ class _Reading:
     held: object
     all_fit: object
     held_desc: str
+    pairs: list = field(default_factory=list)
+    rref: object = None
 
 
-def _diagnose(model, frfs, validate, alpha, refit, noise, out_dir, progress, only, mbi) -> Diagnosis:
+def _diagnose(model, frfs, validate, alpha, refit, noise, out_dir, progress, only, mbi, repeat=None) -> Diagnosis:
     """:func:`diagnose`, step by step (its arguments in the same order)."""
     t0 = time.perf_counter()
 
@@ -160,7 +178,7 @@ def _diagnose(model, frfs, validate, alpha, refit, noise, out_dir, progress, onl
         if progress is not None:
             progress(stage, frac)
 
-    d, notes = _read(model, frfs, validate, alpha, noise, tell)
+    d, notes = _read(model, frfs, validate, alpha, noise, tell, repeat)
     # 1. what the simulation gets wrong
     before, rows, summary, unmatched = _what_is_wrong(d)
     # 2. the hypotheses, screened, the best refitted on the extended model, the verdict
@@ -172,12 +190,15 @@ def _diagnose(model, frfs, validate, alpha, refit, noise, out_dir, progress, onl
     # 4. the extended model and its gain on held-out data
     text, quality, err_before, err_after, gain, comps, held_quality, status = _held_out(
         d, verdict, none, effects, quality, first, before, alpha, notes, tell)
+    # where the misfit of the fitted data lives: asked of the status those data give
     localized = _localized(d, status, notes, tell)
+    # 4b. the same channels at another excitation level: amplitude dependence
+    amplitude, status = _amplitude_dependence(d, status, comps, effects, alpha, notes, tell)
     result = Diagnosis(d.eng.name, d.path, d.ref.sigma, findings, verdict, ambiguous, sensor, err_before, err_after,
                        gain, d.held_desc, comps, rows, summary, threshold, alpha, len(hyps), text,
                        time.perf_counter() - t0, notes, N, status=status, effects=effects, fit_quality=quality,
                        noise_reference=d.ref, unmatched=unmatched, localized=localized,
-                       held_quality=held_quality)
+                       held_quality=held_quality, amplitude=amplitude)
     # 5. data taken at speed: sidebands, a crack turning with the shaft
     _at_speed(result, d, effects, text, findings, verdict, err_after, rss0, tell, t0)
     # 6. model-based identification at the finding, or where the misfit lives
@@ -188,20 +209,25 @@ def _diagnose(model, frfs, validate, alpha, refit, noise, out_dir, progress, onl
     return result
 
 
-def _read(model, frfs, validate, alpha, noise, tell):
+def _read(model, frfs, validate, alpha, noise, tell, repeat=None):
     """The model file and the data, checked; the noise level; the engineering model's receptance and the data
     sets: ``(reading, notes on the inputs)``."""
     # a rotor's model is built (symbolic finite elements) while the files are read: seconds to tens of seconds
     tell("reading the model file and the data (a rotor's finite elements are built here)", 0.0)
-    path, eng, model_text, chans, vchans, speed, input_notes = _inputs(model, frfs, validate, alpha)
+    path, eng, model_text, chans, vchans, speed, input_notes, pairs = _inputs(model, frfs, validate, alpha, repeat)
     tell("noise level of the data (model-free rational fits)", 0.01)
     ref = noise_reference(chans, _noise(noise))
+    rref = None
+    if pairs:
+        tell("noise level of the repeat at another excitation level", 0.015)
+        rref = pair_noise(pairs, _noise(noise))
     s2 = ref.sigma ** 2 / 2.0
     tell("engineering model's receptance", 0.02)
     allf = np.unique(np.concatenate([c.frf.freq_hz for c in chans + vchans]))    # one grid for all
     rec = _Receptance(eng, None, speed, 2 * np.pi * allf)
     fit, held, all_fit, held_desc = _data_sets(rec, allf, chans, vchans)
-    reading = _Reading(path, eng, model_text, chans, vchans, speed, ref, s2, rec, fit, held, all_fit, held_desc)
+    reading = _Reading(path, eng, model_text, chans, vchans, speed, ref, s2, rec, fit, held, all_fit, held_desc,
+                       pairs, rref)
     return reading, input_notes
 
 
@@ -313,6 +339,41 @@ def _held_out_notes(effects, quality, held_quality, gain, status, notes) -> None
     if effects and status == "not explained" and not gain > 1:
         notes.append(f"the extended model fits the held-out data worse than the engineering model "
                      f"(gain {gain:.3g}x): it is not a fix")
+
+
+def _amplitude_dependence(d, status, comps, effects, alpha, notes, tell):
+    """The same channels at another excitation level compared (:mod:`mutext.diagnose._amplitude`): ``(the
+    test or None, the status)``.  Levels that differ beyond the noise make the status at most *partly
+    explained*: when the final model fits the lower-level data (the fitted data unless the files say the
+    repeat is lower); otherwise *not explained*.  The first note says so."""
+    if not d.pairs:
+        return None, status
+    tell("the repeated sweeps at another excitation level (amplitude dependence)", 0.952)
+    test = level_test(d.pairs, d.rref, alpha)
+    reps = list({id(p.rep): p.rep for p in d.pairs}.values())
+    describe_levels(test, [c.frf for c in d.chans + d.vchans], [r.frf for r in reps])
+    test.files = [_src(r.frf, k) for k, r in enumerate(reps, start=1)]
+    if not test.significant:
+        notes.append(test.sentence())
+        return test, status
+    if test.lower == "repeat":
+        # the final model on the repeat's lines (the lower level): at the noise there?
+        model_of = {id(c): (cmp.after if cmp.after is not None else cmp.before)
+                    for c, cmp in zip(d.chans + d.vchans, comps)}
+        with np.errstate(all="ignore"):
+            rs = [np.log(model_of[id(p.chan)][p.ia] / p.rep.frf.response[p.ib]) for p in d.pairs]
+        q = fit_quality(rs, [p.chan.frf.freq_hz[p.ia] for p in d.pairs], [p.chan.label for p in d.pairs],
+                        d.rref.sigma ** 2 / 2.0, len(effects), d.rref, alpha)
+        fits, where = q.at_noise, "the repeat's (lower-level) data"
+    else:
+        fits, where = status == "explained", "the fitted data" + (" (the lower level)" if test.lower else "")
+    new = "partly explained" if fits else "not explained"
+    what = "; ".join(e.sentence() for e in effects) or "the engineering model"
+    notes.insert(0, f"{test.sentence()}. No linear time-invariant model holds at both levels: "
+                 + (f"{what} fits {where} at the noise, a linearisation at that level, not the cause"
+                    if fits else f"the best linear model ({what}) does not fit {where} at the noise")
+                 + "; an extended model is written as not confirmed")
+    return test, new
 
 
 def _localized(d, status, notes, tell):
@@ -464,8 +525,9 @@ def _sideband_claim(result) -> None:
                            if result.verdict.kind == "crack" else ""))
 
 
-def _inputs(model, frfs, validate, alpha):
-    """The model file and the channels, checked: (path, model, text, fit channels, held-out channels, speed)."""
+def _inputs(model, frfs, validate, alpha, repeat=None):
+    """The model file and the channels, checked: (path, model, text, fit channels, held-out channels, speed,
+    notes, the repeated channels paired with their measured twins)."""
     if not isinstance(model, (str, os.PathLike)):
         raise ModelError("diagnose: give the model as a model file path (TOML); the extended model is "
                          "written from it")
@@ -479,7 +541,8 @@ def _inputs(model, frfs, validate, alpha):
     if not fit_frfs:
         raise ModelError("diagnose: no measured FRF given")
     val_frfs = _as_frfs(validate)
-    for group, what in ((fit_frfs, "measured"), (val_frfs, "validation")):
+    rep_frfs = _as_frfs(repeat)
+    for group, what in ((fit_frfs, "measured"), (val_frfs, "validation"), (rep_frfs, "repeated")):
         for i, a in enumerate(group):
             for b in group[:i]:
                 if _same_data(a, b):
@@ -491,17 +554,25 @@ def _inputs(model, frfs, validate, alpha):
             if _same_data(v, f):
                 raise ModelError(f"validation file {_src(v, 0)} holds the same data as the fitted "
                                  f"{_src(f, 0)}: held-out data must not be used in the fit")
+    for r in rep_frfs:
+        for f in fit_frfs + val_frfs:
+            if _same_data(r, f):
+                raise ModelError(f"repeat {_src(r, 0)} holds the same data as {_src(f, 0)}: a repeat is a new "
+                                 "measurement of the channel at another excitation level")
     notes: list = []
     if eng.layout.kind == "lumped":
         # a chain moves along one direction: a file's Y (an analyser's default axis) is that direction
         fit_frfs, val_frfs = _along_the_chain(fit_frfs, notes), _along_the_chain(val_frfs, notes)
-    for k, f in enumerate(fit_frfs + val_frfs, start=1):
+        rep_frfs = _along_the_chain(rep_frfs, notes)
+    for k, f in enumerate(fit_frfs + val_frfs + rep_frfs, start=1):
         for n in (f.metadata.get("notes") or []):
             notes.append(f"{_src(f, k)}: {n}")
         if f.metadata.get("conversion"):
             notes.append(f"{_src(f, k)}: {f.metadata['conversion']}")
     chans, _ = _resolve(eng, fit_frfs, "data")
     vchans, _ = _resolve(eng, val_frfs, "validation") if val_frfs else ([], None)
+    # the repeat at another excitation level: each channel with its measured twin (errors name the file)
+    pairs = pair_channels(chans + vchans, _resolve(eng, rep_frfs, "repeat")[0]) if rep_frfs else []
     speeds = {c.speed for c in chans + vchans}
     if len(speeds) > 1:
         raise ModelError(f"diagnose: the FRFs were measured at different running speeds "
@@ -515,7 +586,7 @@ def _inputs(model, frfs, validate, alpha):
         raise ModelError(f"diagnose: the data cover {fmin:g}-{fmax:g} Hz but the model has no resonance there "
                          f"(model resonances: {', '.join(f'{x:.4g}' for x in fmodes[:6])} Hz): check the units of "
                          f"the frequency column and that the file belongs to this model")
-    return path, eng, model_text, chans, vchans, speed, list(dict.fromkeys(notes))
+    return path, eng, model_text, chans, vchans, speed, list(dict.fromkeys(notes)), pairs
 
 
 def _noise(noise) -> float | None:

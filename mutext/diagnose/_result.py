@@ -286,6 +286,9 @@ class Diagnosis:
         Where an unexplained misfit lives (:mod:`mutext.diagnose._localize`).
     held_quality : FitQuality or None
         Lack-of-fit test of the final model on the held-out data.
+    amplitude : LevelTest or None
+        The same channels measured at another excitation level compared
+        (:mod:`mutext.diagnose._amplitude`), when a repeat was given.
     """
     model_name: str
     model_source: str | None
@@ -319,6 +322,7 @@ class Diagnosis:
     unmatched: dict | None = None   # resonances without a partner: {"measured": [...], "model": [...]}
     localized: dict | None = None   # where an unexplained misfit lives (mutext.diagnose._localize)
     held_quality: object = None     # the lack-of-fit test of the final model on the held-out data
+    amplitude: object = None        # _amplitude.LevelTest: the repeat at another excitation level
 
     @property
     def confirmed(self) -> bool:
@@ -327,7 +331,21 @@ class Diagnosis:
         return self.status == "explained" and bool(self.effects)
 
     def headline(self) -> str:
-        """The verdict in one line: the status first, then what was found."""
+        """The verdict in one line: the status first, then what was found (a response that depends on the
+        excitation level before anything else)."""
+        amp = self.amplitude
+        if amp is not None and amp.significant:
+            eff = "; ".join(f.sentence() for f in self.effects) or "the engineering model"
+            if self.status == "partly explained":
+                rest = (f"no linear model holds at both levels; at one level {eff} fits at the noise "
+                        "(a linearisation there, not the cause)")
+            else:
+                rest = "no linear model holds at both levels; " + self._headline().split(": ", 1)[1]
+            return f"{self.status.upper()}: {amp.sentence()}; {rest}"
+        return self._headline()
+
+    def _headline(self) -> str:
+        """The verdict in one line without the repeat at another excitation level."""
         q = self.fit_quality
         eff = "; ".join(f.sentence() for f in self.effects) or "no effect beyond the noise"
         if self.status == "explained":
@@ -371,6 +389,7 @@ class Diagnosis:
             "held_out_quality": None if self.held_quality is None else self.held_quality.as_dict(),
             "noise_reference": None if self.noise_reference is None else self.noise_reference.as_dict(),
             "unmatched_resonances": self.unmatched,
+            "amplitude_dependence": None if self.amplitude is None else self.amplitude.as_dict(),
             "localized": None if self.localized is None else {
                 k: ([[float(x.real), float(x.imag)] for x in v] if k in ("required_impedance", "msd_fit") else v)
                 for k, v in self.localized.items()},
