@@ -8,6 +8,7 @@ import os
 from ..rotor.model import load_model
 from ._channels import _resolve
 from .faults import absorber as _absorber
+from .faults import bearing_cross as _bearing_cross
 from .faults import channel as _channel
 from .faults import crack as _crack
 from .faults import distributed as _distributed
@@ -17,11 +18,11 @@ from .faults import rotor as _rotor
 from .faults import structure as _structure
 from .faults._base import Hypothesis
 
-__all__ = ["KINDS", "Hypothesis", "hypotheses", "write_finding"]
+__all__ = ["KINDS", "Hypothesis", "hypotheses", "data_candidates", "write_finding"]
 
 #: Kinds of finding (the ``kind`` field of :class:`~mutext.diagnose.Finding`).
-KINDS = (("stiffness", "mass", "damping", "crack", "bearing") + _absorber.KINDS + _distributed.KINDS
-         + _pedestal.KINDS + _channel.KINDS + _structure.KINDS + ("none",))
+KINDS = (("stiffness", "mass", "damping", "crack", "bearing") + _bearing_cross.KINDS + _absorber.KINDS
+         + _distributed.KINDS + _pedestal.KINDS + _channel.KINDS + _structure.KINDS + ("none",))
 
 
 def hypotheses(model, frfs=None, *, stations=None) -> list[Hypothesis]:
@@ -32,7 +33,8 @@ def hypotheses(model, frfs=None, *, stations=None) -> list[Hypothesis]:
     model : Structure, Rotor or str
         The engineering model, or the path of its model file.
     frfs : sequence of mutext.response.FRF, optional
-        The measured channels (adds the measurement-chain hypotheses).
+        The measured channels (adds the measurement-chain hypotheses, and a bearing's cross-coupled
+        stiffness when a channel crosses the bending planes: :func:`data_candidates`).
     stations : sequence of int, optional
         Stations at which rotor and crack hypotheses are formed (default: all).
     """
@@ -45,8 +47,28 @@ def hypotheses(model, frfs=None, *, stations=None) -> list[Hypothesis]:
         hyps = _rotor.candidates(model, stations) + _crack.candidates(model, stations)
     if frfs is not None:
         chans, _ = _resolve(model, list(frfs), "FRF")
-        hyps += _channel.candidates(model, chans)
+        hyps += data_candidates(model, chans, stations=stations)
     return hyps
+
+
+def data_candidates(model, chans, *, stations=None) -> list[Hypothesis]:
+    """The hypotheses the measured channels make testable: the measurement chain's (each channel's sensor,
+    exciter, scale, delay), and on a two-plane rotor whose data cross the planes a skew cross-coupled
+    stiffness at every bearing (:mod:`~mutext.diagnose.faults.bearing_cross`).
+
+    Parameters
+    ----------
+    model : Structure or Rotor
+        The engineering model.
+    chans : sequence
+        The measured channels resolved on ``model`` (:func:`mutext.diagnose._channels._resolve`).
+    stations : sequence of int, optional
+        Stations at which the bearing hypotheses are formed (default: all).
+    """
+    hyps = []
+    if model.layout.kind != "lumped":
+        hyps += _bearing_cross.candidates(model, chans, stations)
+    return hyps + _channel.candidates(model, chans)
 
 
 def write_finding(mf, finding, model, note: str) -> None:
@@ -54,6 +76,8 @@ def write_finding(mf, finding, model, note: str) -> None:
     h = finding.hypothesis
     if h.kind == "absorber":
         home = _absorber
+    elif h.kind == "cross_coupling":
+        home = _bearing_cross
     elif h.kind == "distributed_stiffness":
         home = _distributed
     elif h.kind == "pedestal":
