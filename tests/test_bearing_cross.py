@@ -116,6 +116,23 @@ def test_kxy_kyx_are_read_signed_and_written_back():
     assert tomllib.loads(out)["bearing"][1]["kxy"] == -2.5e4
 
 
+def test_undamped_modes_keep_the_circulatory_part():
+    """Without damping and rotation the modes are not those of the symmetric part of K: a skew
+    cross-coupling splits each pair into a decaying and a growing whirl (flutter)."""
+    t = (ROTOR.replace("speed_rpm = 600", "speed_rpm = 0").replace("[damping]\nmodal = 0.01\n", "")
+         .replace("damping = 20.0", "damping = 0.0"))
+    m = loads_model(_bearing(t, kxy=2.0e5, kyx=-2.0e5), source="undamped")
+    M, _, K, _ = m.matrices()
+    n = M.shape[0]
+    A = np.block([[np.zeros((n, n)), np.eye(n)], [-np.linalg.solve(M, K), np.zeros((n, n))]])
+    lam = np.linalg.eigvals(A)
+    lam = lam[lam.imag > 0]
+    lam = lam[np.argsort(lam.imag)][:4]
+    ev = m.modes().eigenvalues[:4]
+    assert np.allclose(np.sort_complex(ev), np.sort_complex(lam), rtol=1e-9)
+    assert max(ev.real) > 0 > min(ev.real)
+
+
 def test_bad_cross_coupling_values_are_named():
     with pytest.raises(ModelError, match=r"\[\[bearing\]\] #2, kxy.*finite number"):
         loads_model(_bearing(ROTOR, kxy='"stiff"'), source="small.toml")
