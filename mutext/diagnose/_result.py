@@ -337,7 +337,10 @@ class Diagnosis:
         if amp is not None and amp.significant:
             eff = "; ".join(f.sentence() for f in self.effects) or "the engineering model"
             if self.status == "partly explained":
-                rest = (f"no linear model holds at both levels; at one level {eff} fits at the noise "
+                at = amp.levels[1] if amp.lower == "repeat" else amp.levels[0]
+                at = f"at {at}" if at else ("at the lower level" if amp.lower == "repeat" else
+                                            "at the level of the fitted data")
+                rest = (f"no linear model holds at both levels; {at} {eff} fits at the noise "
                         "(a linearisation there, not the cause)")
             else:
                 rest = "no linear model holds at both levels; " + self._headline().split(": ", 1)[1]
