@@ -29,6 +29,9 @@ modal
     :func:`mode_shapes`: the modes at a speed along the shaft, with log decrement and whirl.
 unbalance
     :func:`unbalance_response`: steady 1x response to unbalance at probes (Bode, polar), run-up.
+transient
+    :func:`transient_run_up`: run-up or coast-down through the critical speeds at a finite
+    acceleration, the response in time and its envelope against speed.
 sparse_modal
     :func:`sparse_modes`: the lowest modes at speed by shift-invert Arnoldi (fine meshes).
 periodic_orbit
@@ -78,6 +81,7 @@ from .campbell_diagram import CampbellDiagram, Crossing, campbell
 from .modal import ModeShapes, mode_shapes
 from .orbits import Ellipse, Orbit, ellipse, orbit
 from .unbalance import UnbalanceResponse, run_up, unbalance_response
+from .transient import TransientRunUp, transient_run_up
 from .periodic_orbit import PeriodicResponse, periodic_unbalance_response
 from .sparse_modal import sparse_modes
 from .directional import DirectionalFRF, PlanarFRF, WhirlPeak, directional_frf, planar_rotor, whirl_peaks
@@ -96,6 +100,7 @@ __all__ = [
     "FRFSensitivity", "TuneResult", "frf_sensitivity", "model_response", "tune",
     "CampbellDiagram", "Crossing", "campbell", "ModeShapes", "mode_shapes", "Ellipse", "Orbit", "ellipse", "orbit",
     "UnbalanceResponse", "run_up", "unbalance_response", "rpm_to_rad_s", "rad_s_to_rpm",
+    "TransientRunUp", "transient_run_up",
     "PeriodicResponse", "periodic_unbalance_response", "sparse_modes",
     "DirectionalFRF", "PlanarFRF", "WhirlPeak", "directional_frf", "planar_rotor", "whirl_peaks",
 ]
