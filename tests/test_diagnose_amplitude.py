@@ -168,3 +168,15 @@ def test_false_alarms_of_the_repeat_test_stay_near_alpha():
             flagged += level_test(pairs, pair_noise(pairs), alpha).significant
     # binomial(300, 0.05): 15 +/- 3.8
     assert 4 <= flagged <= 27, flagged
+
+
+def test_fitted_at_the_higher_level_the_model_is_judged_on_the_lower_one(cubic):
+    """The files say the repeat is the lower level: the linear model fitted at 1 N is held against the 0.2 N
+    sweeps, which it does not fit (the linearisation at 1 N is not the one at 0.2 N)."""
+    path, low, high, _, _ = cubic
+    d = diagnose(path, high, repeat=low, refit=0, only=lambda h: h.kind == "stiffness")
+    amp = d.amplitude
+    assert amp.significant and amp.levels == ("1 N", "0.2 N") and amp.lower == "repeat"
+    assert d.status == "not explained" and not d.confirmed, d.report()
+    assert "does not fit the repeat's (lower-level) data at the noise" in d.notes[0]
+    assert d.headline().startswith("NOT EXPLAINED: the response depends on the excitation level (measured at 1 N")

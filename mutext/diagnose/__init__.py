@@ -43,7 +43,11 @@ held-out data, but a residual above the noise remains (where, in frequency and
 by channel, is reported, and the uncertainties are inflated by the misfit).
 *Not explained*: nothing found does better on held-out data, or no effect is
 significant while the residual is above the noise.  A size at a bound of its
-range is never significant.
+range is never significant.  Given the same channels measured again at another
+excitation level (``repeat=``), a response that depends on the level (a
+nonlinear structure, which no hypothesis here can hold) is tested without a
+model (:mod:`mutext.diagnose._amplitude`); when it does, the verdict says so
+first and the status is at most *partly explained*.
 
 Residual and noise
 ------------------

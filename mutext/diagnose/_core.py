@@ -371,7 +371,7 @@ def _amplitude_dependence(d, status, comps, effects, alpha, notes, tell):
     notes.insert(0, f"{test.sentence()}. No linear time-invariant model holds at both levels: "
                  + (f"{what} fits {where} at the noise, a linearisation at that level, not the cause"
                     if fits else f"the best linear model ({what}) does not fit {where} at the noise")
-                 + "; an extended model is written as not confirmed")
+                 + ("; the extended model is written as not confirmed" if effects else ""))
     return test, new
 
 
