@@ -718,3 +718,49 @@ def orbit_figure(orbits, *, titles=None, title=None):
         ax.grid(True, alpha=0.3)
         ax.set_title((titles[j] if titles else o.label), fontsize=8)
     return _finish(fig, title, fontsize=10)
+
+
+def run_up_figure(result, *, others=(), trace: bool = True, title=None):
+    """Envelope of a transient run-up or coast-down (:class:`mutext.rotor.TransientRunUp`) against speed
+    [rpm]: the largest orbit radius [µm] in each revolution at every output station, the radius itself
+    (thin, ``trace``), the peak marked, and the steady unbalance response (semi-major axis) dashed.
+
+    Parameters
+    ----------
+    result : mutext.rotor.TransientRunUp
+        The run (:func:`mutext.rotor.transient_run_up`).
+    others : sequence of mutext.rotor.TransientRunUp, optional
+        More runs drawn on the same axes (a coast-down beside the run-up, another acceleration); the
+        steady response is drawn once, from ``result``.
+    trace : bool, optional
+        Draw the orbit radius at every time step too.
+    title : str, optional
+        Title of the figure.
+    """
+    plt = _plt()
+    fig, ax = plt.subplots(figsize=(7.0, 4.0))
+    runs = [result, *others]
+    for i, r in enumerate(runs):
+        kind = "run-up" if r.acceleration > 0 else "coast-down" if r.acceleration < 0 else "constant speed"
+        for j, st in enumerate(r.stations):
+            color = f"C{(i * len(r.stations) + j) % 10}"
+            if trace:
+                ax.plot(r.speed_rpm, 1e6 * r.radius[:, j], color=color, lw=0.4, alpha=0.35)
+            ax.plot(r.rev_speed_rpm, 1e6 * r.envelope[:, j], color=color, lw=1.4,
+                    label=f"{kind} {abs(r.acceleration) * 30 / np.pi:.0f} rpm/s, station {st}")
+            w, a = r.peak(j)
+            ax.plot([w * 30 / np.pi], [1e6 * a], "o", color=color, ms=5)
+            ax.annotate(f"{w * 30 / np.pi:.0f} rpm", (w * 30 / np.pi, 1e6 * a), textcoords="offset points",
+                        xytext=(4, 4), fontsize=7, color=color)
+    for j, st in enumerate(result.stations):
+        ax.plot(result.steady.speeds_rpm, 1e6 * result.steady.semi_major[:, j], "k--", lw=0.9,
+                label=f"steady, station {st}")
+    ax.set_xlabel("speed [rpm]")
+    ax.set_ylabel("orbit radius [µm, 0-peak]")
+    ax.set_ylim(bottom=0)
+    ax.grid(True, alpha=0.3)
+    ax.legend(fontsize=7)
+    u = ", ".join(f"{1e6 * m:g} g mm at station {s}" for s, m, _ in result.unbalances)
+    ax.set_title(title or f"transient run-up through the critical speeds ({u})", fontsize=10)
+    fig.tight_layout()
+    return fig

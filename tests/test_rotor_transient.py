@@ -163,3 +163,52 @@ def test_bad_input_is_named():
     with pytest.raises(ModelError, match="two bending planes"):
         transient_run_up(Rotor([DiskElement(1, 1.0, 0.0, 1.0), BearingElement(1, 1e4)], planes=1),
                          (100.0, 300.0), ub, 1, duration=1.0)
+
+
+# ----------------------------------------------------------------------------- figure and command line
+
+def test_run_up_figure_draws_the_envelope_and_the_steady_response():
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    from mutext import plots
+    m, k, c, U = 2.0, 8.0e4, 16.0, 1e-4
+    up = transient_run_up(jeffcott(m, k, c), (100.0, 300.0), (1, U, 1.0), 1, duration=0.5)
+    down = transient_run_up(jeffcott(m, k, c), (300.0, 100.0), (1, U, 1.0), 1, duration=0.5)
+    fig = plots.run_up_figure(up, others=[down], trace=False)
+    lines = fig.axes[0].lines
+    np.testing.assert_allclose(lines[0].get_ydata(), 1e6 * up.envelope[:, 0])
+    np.testing.assert_allclose(lines[0].get_xdata(), up.rev_speed * 30 / np.pi)
+    np.testing.assert_allclose(lines[2].get_ydata(), 1e6 * down.envelope[:, 0])
+    np.testing.assert_allclose(lines[-1].get_ydata(), 1e6 * up.steady.semi_major[:, 0])
+    assert lines[-1].get_linestyle() == "--"
+    plt.close("all")
+
+
+def test_cli_rotor_runup(capsys, tmp_path):
+    import json
+
+    from mutext.cli import main
+    from mutext.rotor import data_path
+    png = tmp_path / "runup.png"
+    args = ["rotor", "runup", data_path("rotor.toml"), "--unbalance", "16:0.001:0.01", "--speeds", "1500:2500",
+            "--duration", "0.5", "--output", "16"]
+    assert main(args + ["--plot", str(png), "--json"]) == 0
+    out = json.loads(capsys.readouterr().out)
+    o = out["outputs"][0]
+    assert o["station"] == 16 and png.stat().st_size > 10000
+    assert 2000 < o["steady_peak_speed_rpm"] < 2080 < o["peak_speed_rpm"]
+    assert o["peak_radius_m"] < 0.7 * o["steady_peak_m"]
+    assert out["unbalances"] == [{"station": 16, "kg_m": pytest.approx(1e-5), "phase_rad": 0.0}]
+    assert main(args[:-1] + ["13,16"]) == 0
+    text = capsys.readouterr().out
+    assert "run-up" in text and "steady peak [rpm]" in text and "\n     13 " in text
+    assert main(args[:4] + ["16:0.001", "--speeds", "1500:2500", "--duration", "1", "--output", "16"]) == 2
+    assert "--unbalance" in capsys.readouterr().err
+    assert main(args[:6] + ["2500", "--duration", "1", "--output", "16"]) == 2
+    assert "--speeds" in capsys.readouterr().err
+    assert main(args[:8] + ["-1", "--output", "16"]) == 2
+    assert "--duration" in capsys.readouterr().err
+    assert main(args[:10] + ["99"]) == 1
+    assert "output station" in capsys.readouterr().err

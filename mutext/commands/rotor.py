@@ -1,5 +1,7 @@
 """``mutext rotor campbell MODEL.toml --speeds 0:3000:31 [--modes N] [--orders 1,2,3] [--plot FILE] [--json]``
-and ``mutext rotor whirl MODEL.toml --input PORT --output PORT [--speed RPM] [--freqs START:STOP:COUNT] [--json]``.
+``mutext rotor whirl MODEL.toml --input PORT --output PORT [--speed RPM] [--freqs START:STOP:COUNT] [--json]``
+and ``mutext rotor runup MODEL.toml --unbalance STATION:MASS_KG:RADIUS_M --speeds START:STOP --duration S
+--output STATION [--plot FILE] [--json]``.
 
 ``campbell``: the Campbell diagram of a rotor model file (:func:`mutext.rotor.campbell`):
 the whirl frequencies of the lowest modes against speed, forward or backward,
@@ -12,6 +14,12 @@ included) or as a comma-separated list.
 in y at the input's station, measured in x and y at the output's:
 :func:`mutext.rig.measure_rotor` with ``planes="xy"``), its directional FRFs and
 their resonances labelled forward or backward (:func:`mutext.rotor.whirl_peaks`).
+
+``runup``: the rotor driven through its critical speeds at a constant
+acceleration with an unbalance, integrated in time
+(:func:`mutext.rotor.transient_run_up`): the peak orbit radius at each output
+station and the speed where it occurs, beside the peak of the steady unbalance
+response (lower and later in a run-up, earlier in a coast-down).
 """
 from __future__ import annotations
 
@@ -42,6 +50,7 @@ def add_arguments(p):
     c.add_argument("--json", action="store_true", help="print the whole diagram as one JSON object")
 
     _add_whirl(sub)
+    _add_runup(sub)
 
 def _add_whirl(sub):
     w = sub.add_parser("whirl", help="forward and backward whirl peaks of a two-plane sweep (directional FRFs)",
@@ -58,6 +67,145 @@ def _add_whirl(sub):
     w.add_argument("--freqs", default="20:225:4101", metavar="START:STOP:COUNT",
                    help="sweep frequencies in Hz (default 20:225:4101, a 0.05 Hz step)")
     w.add_argument("--json", action="store_true", help="print the peaks as one JSON object")
+
+
+def _add_runup(sub):
+    r = sub.add_parser("runup", help="transient run-up or coast-down through the critical speeds with an unbalance",
+                       description="Drive the rotor from START to STOP rpm at a constant acceleration with an "
+                                   "unbalance, integrate the response in time (Newmark, on the lowest modes plus "
+                                   "the static shapes of the unbalance forces), and print the peak orbit radius "
+                                   "at each output beside the steady unbalance response's peak.")
+    r.add_argument("model", metavar="MODEL.toml", help="rotor model file (two bending planes)")
+    r.add_argument("--unbalance", required=True, action="append", metavar="STATION:MASS_KG:RADIUS_M[:PHASE_DEG]",
+                   help="an unbalance mass at a station (repeat the option for more)")
+    r.add_argument("--speeds", required=True, metavar="START:STOP",
+                   help="start and stop speeds in rpm (STOP < START: a coast-down)")
+    how = r.add_mutually_exclusive_group(required=True)
+    how.add_argument("--duration", type=float, metavar="S", help="length of the run in seconds")
+    how.add_argument("--acceleration", type=float, metavar="RPM_PER_S", help="rate of the speed change in rpm/s")
+    r.add_argument("--output", required=True, action="append", metavar="STATION",
+                   help="station whose orbit is recorded (repeat, or a comma-separated list)")
+    r.add_argument("--modes", type=int, default=None, metavar="N",
+                   help="undamped modes kept (default: those up to four times the top speed)")
+    r.add_argument("--plot", metavar="FILE", help="save the envelope against speed as an image (PNG, SVG or PDF)")
+    r.add_argument("--json", action="store_true", help="print the peaks and envelopes as one JSON object")
+
+
+def _unbalance_arg(text: str):
+    """``STATION:MASS_KG:RADIUS_M[:PHASE_DEG]`` -> (station, mass, radius, phase_rad), or a UsageError."""
+    from ..errors import UsageError
+    parts = str(text).split(":")
+    try:
+        if len(parts) not in (3, 4):
+            raise ValueError
+        st, m, e = int(parts[0]), float(parts[1]), float(parts[2])
+        ph = math.radians(float(parts[3])) if len(parts) == 4 else 0.0
+        if not all(math.isfinite(v) for v in (m, e, ph)) or m < 0 or e < 0:
+            raise ValueError
+    except ValueError:
+        raise UsageError(f"--unbalance {text!r}: expected STATION:MASS_KG:RADIUS_M[:PHASE_DEG] with a non-negative "
+                         "mass and radius (e.g. 16:0.001:0.01)") from None
+    return st, m, e, ph
+
+
+def _outputs_arg(values):
+    from ..errors import UsageError
+    out = []
+    for text in values:
+        for part in str(text).split(","):
+            if not part.strip().isdigit():
+                raise UsageError(f"--output {text!r}: expected station numbers (e.g. 16 or 13,16)")
+            out.append(int(part))
+    return out
+
+
+def run_runup(args) -> int:
+    """``mutext rotor runup``: the transient run-up's peaks beside the steady response's.
+
+    Parameters
+    ----------
+    args : argparse.Namespace
+        The parsed command line.
+
+    Returns
+    -------
+    int
+        The exit status.
+    """
+    import os
+
+    from ..errors import ModelError, UsageError
+    from ..jsonio import print_json
+    from ..rotor import load_model, rpm_to_rad_s, transient_run_up
+    parts = str(args.speeds).split(":")
+    try:
+        if len(parts) != 2:
+            raise ValueError
+        a, b = float(parts[0]), float(parts[1])
+        if not (math.isfinite(a) and math.isfinite(b)) or a < 0 or b < 0 or a == b:
+            raise ValueError
+    except ValueError:
+        raise UsageError(f"--speeds {args.speeds!r}: expected START:STOP in rpm, two different non-negative "
+                         "speeds (e.g. 1000:3000, or 3000:1000 for a coast-down)") from None
+    if args.duration is not None and not (math.isfinite(args.duration) and args.duration > 0):
+        raise UsageError(f"--duration {args.duration}: expected a positive time in seconds")
+    if args.acceleration is not None and not (math.isfinite(args.acceleration) and args.acceleration > 0):
+        raise UsageError(f"--acceleration {args.acceleration}: expected a positive rate in rpm/s")
+    if args.modes is not None and args.modes < 1:
+        raise UsageError(f"--modes must be a positive integer, got {args.modes}")
+    unbalance = [_unbalance_arg(u) for u in args.unbalance]
+    outputs = _outputs_arg(args.output)
+    _check_plot(args.plot)
+    if not os.path.isfile(args.model):
+        raise ModelError(f"{args.model}: no such model file")
+    model = load_model(args.model)
+    kw = {"duration": args.duration} if args.duration is not None else \
+        {"acceleration": float(rpm_to_rad_s(args.acceleration))}
+    r = transient_run_up(model, (float(rpm_to_rad_s(a)), float(rpm_to_rad_s(b))), unbalance, outputs,
+                         modes=args.modes, **kw)
+    if args.plot:
+        from .. import plots
+        from .._mpl import pyplot
+        fig = plots.run_up_figure(r)
+        fig.savefig(args.plot, dpi=120)
+        pyplot().close(fig)
+    if args.json:
+        out = r.to_dict()
+        if args.plot:
+            out["plot"] = args.plot
+        print_json(out)
+        return 0
+    kind = "run-up" if b > a else "coast-down"
+    rate = abs(r.acceleration) * 30 / math.pi
+    print(f"{kind} of {model.name}: {a:g} -> {b:g} rpm in {r.t[-1]:.3g} s ({rate:.4g} rpm/s), "
+          f"{r.t.size - 1} steps of {r.dt:.3g} s, {r.basis_hz.size} coordinates (modes and static shapes)")
+    for s, u, p in r.unbalances:
+        print(f"  unbalance {1e6 * u:g} g mm at station {s}, {math.degrees(p):g} deg")
+    print(f"\n{'station':>7} {'peak [rpm]':>11} {'peak [um]':>10} {'steady peak [rpm]':>18} {'steady [um]':>12}"
+          f" {'ratio':>6}")
+    for j, st in enumerate(r.stations):
+        w, amp = r.peak(j)
+        ws, amps = r.steady_peak(j)
+        print(f"{st:>7} {w * 30 / math.pi:>11.1f} {1e6 * amp:>10.4g} {ws * 30 / math.pi:>18.1f} {1e6 * amps:>12.4g}"
+              f" {amp / amps:>6.3f}")
+    print("\norbit radius, 0-peak; steady: the semi-major axis of the steady unbalance response")
+    if args.plot:
+        print(f"\nplot: {args.plot}")
+    return 0
+
+
+def _check_plot(path):
+    import os
+
+    from ..errors import ModelError, UsageError
+    if not path:
+        return
+    ext = os.path.splitext(path)[1].lower()
+    if ext not in (".png", ".svg", ".pdf"):
+        raise UsageError(f"--plot {path}: the extension must be .png, .svg or .pdf")
+    d = os.path.dirname(os.path.abspath(path))
+    if not os.path.isdir(d):
+        raise ModelError(f"--plot {path}: the directory {d} does not exist")
 
 
 def _port(text: str):
@@ -210,6 +358,8 @@ def run(args) -> int:
     """
     if args.action == "whirl":
         return run_whirl(args)
+    if args.action == "runup":
+        return run_runup(args)
     import os
 
     from ..errors import ModelError, UsageError
