@@ -134,7 +134,6 @@ def test_the_command_line_takes_a_repeat_and_names_a_bad_one(tmp_path, capsys):
     assert main(["diagnose", "--batch", str(tmp_path), "--repeat", bad]) == 2
 
 
-@pytest.mark.slow
 def test_the_command_line_reports_the_repeat_and_its_levels(cubic, tmp_path, capsys):
     from mutext.cli import main
     from mutext.rig import write_frf
