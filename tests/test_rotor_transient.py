@@ -117,7 +117,13 @@ def test_slower_run_up_comes_closer_to_the_steady_peak():
 def test_steady_initial_state_starts_on_the_steady_response():
     m, k, zeta, U = 2.0, 8.0e4, 0.02, 1e-4
     c = 2 * zeta * math.sqrt(k * m)
-    r = transient_run_up(jeffcott(m, k, c), (150.0, 150.0), (1, U, 1.0, 0.3), 1, duration=0.2)
+    calls = []
+    r = transient_run_up(jeffcott(m, k, c), (150.0, 150.0), (1, U, 1.0, 0.3), 1, duration=0.2,
+                         progress=lambda stage, fraction: calls.append((stage, fraction)))
+    assert [c_ for c_ in calls if c_[0] != "integrate"] == [("reduce", 0.0), ("reduce", 1.0), ("steady", 0.0),
+                                                           ("steady", 1.0)]
+    done = [f for s_, f in calls if s_ == "integrate"]
+    assert done == sorted(done) and done[-1] == 1.0
     X = U * 150.0 ** 2 * np.exp(0.3j) / (k - m * 150.0 ** 2 + 1j * c * 150.0)
     np.testing.assert_allclose(r.X1[:, 0], X, rtol=2e-3)                 # from the first revolution on
     np.testing.assert_allclose(r.Y1[:, 0], -1j * X, rtol=2e-3)
