@@ -218,7 +218,7 @@ def _two_plane_files(extra, seed, out_dir):
                           input_direction="x" if force is None else force[1], output_direction=d,
                           speed_hz=10.0)
             p = os.path.join(out_dir, f"{what}{k}_{'i12' if force is None else 'F12y'}_{d}{s}.csv")
-            write_frf(frf, p)
+            write_frf(p, frf)
             paths[what].append(p)
     return paths, r
 
