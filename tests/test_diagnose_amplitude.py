@@ -179,3 +179,15 @@ def test_fitted_at_the_higher_level_the_model_is_judged_on_the_lower_one(cubic):
     assert d.status == "not explained" and not d.confirmed, d.report()
     assert "does not fit the repeat's (lower-level) data at the noise" in d.notes[0]
     assert d.headline().startswith("NOT EXPLAINED: the response depends on the excitation level (measured at 1 N")
+
+
+def test_the_excitation_level_is_read_from_a_csv_header_or_a_universal_file_id_line(tmp_path):
+    from mutext.diagnose._amplitude import _lower, level_of
+    from mutext.rig import read_frf, write_frf
+    f = FRF(np.array([1.0, 2.0]), np.array([1e-3, 2e-3j]), input_station=1, output_station=1,
+            metadata={"excitation": "0.5 N"})
+    assert level_of(read_frf(write_frf(tmp_path / "a.csv", f))) == "0.5 N"
+    assert level_of(replace(f, metadata={"uff_id2": "mutext excitation=2N"})) == "2N"
+    assert level_of(replace(f, metadata={})) is None
+    assert _lower("0.5 N", "2 N") == "measured" and _lower("2N", "0.5N") == "repeat"
+    assert _lower("0.5 N", "0.1 A") is None and _lower(None, "1 N") is None and _lower("1 N", "1 N") is None
