@@ -32,7 +32,8 @@ File format
   Optional: ``speed_hz`` (float, running speed), ``input_direction`` and
   ``output_direction`` (``x`` or ``y``, the plane of a rotor; default ``x``),
   ``input_name`` and ``output_name`` (the model's port names).  Any other ``# key: value`` is kept
-  as metadata (strings).  A combination-frequency response (a time-periodic
+  as metadata (strings); ``excitation`` (the sweep's force or current amplitude, e.g. ``2 N``) is
+  reported by ``mutext diagnose --repeat`` (sweeps at two levels compared).  A combination-frequency response (a time-periodic
   rotor's response at :math:`f + kF` to excitation at :math:`f`, written by
   :func:`measure_rotor` with ``combination=``) says so with ``order: k``
   (integer, not 0) and ``response_frequency: f_exc + k * speed_hz``; its rows
