@@ -129,7 +129,8 @@ def refined_rotor(out_dir, r: int) -> str:
     return str(path)
 
 
-def run_case(r: int, kind: str, seed: int, work: Path, noise: float = 0.01, profile: bool = False) -> dict:
+def run_case(r: int, kind: str, seed: int, work: Path, noise: float = 0.01, profile: bool = False,
+             refit: int = 0) -> dict:
     """One hidden effect in the ``r``-times refined rotor, diagnosed: the figures of one table row."""
     import numpy as np
 
@@ -167,7 +168,7 @@ def run_case(r: int, kind: str, seed: int, work: Path, noise: float = 0.01, prof
         c0 = time.process_time()
         if prof:
             prof.enable()
-        d = diagnose(f["model"], f["measured"], validate=f["validate"], refit=0)
+        d = diagnose(f["model"], f["measured"], validate=f["validate"], refit=refit)
         if prof:
             prof.disable()
         cpu = time.process_time() - c0
@@ -183,7 +184,7 @@ def run_case(r: int, kind: str, seed: int, work: Path, noise: float = 0.01, prof
     v = d.verdict
     return {"r": r, "stations": n, "dofs": ndof, "kind": kind, "seed": seed, "cpu": cpu, "peak_mb": peak / 1e6,
             "largest": f"{big[1]} {big[2]} {big[0] / 1e6:.1f} MB", "hypotheses": d.n_hypotheses,
-            "verdict": f"{v.kind} at {v.station}", "value": float(v.value), "key": f"{key['kind']} at {key['station']}",
+            "verdict": f"{v.kind} at {v.station}", "value": float(v.value), "std": float(v.std), "key": f"{key['kind']} at {key['station']}",
             "key_value": float(key["value"]), "right": (v.kind, v.station) == (key["kind"], key["station"])}
 
 
@@ -192,7 +193,7 @@ HEAD = (f"{'stations':>8} {'dofs':>5} {'hyps':>5} {'CPU s':>8} {'peak MB':>8}  {
 
 
 def line(row) -> str:
-    found = "{} ({:.4g})".format(row["verdict"], row["value"])
+    found = "{} ({:.4g} +/- {:.2g})".format(row["verdict"], row["value"], row["std"])
     answer = "{} ({:.4g})".format(row["key"], row["key_value"])
     return (f"{row['stations']:>8} {row['dofs']:>5} {row['hypotheses']:>5} {row['cpu']:>8.2f} {row['peak_mb']:>8.1f}  "
             f"{row['largest']:<34} {found:<26} {answer:<26} {'yes' if row['right'] else 'NO'}")
@@ -204,6 +205,9 @@ def main(argv=None) -> int:
     p.add_argument("--cases", nargs="+", default=["crack:4", "mass:1"],
                    help="hidden effects as kind:seed (default crack:4 mass:1)")
     p.add_argument("--profile", type=int, default=None, help="cProfile the diagnosis at this refinement")
+    p.add_argument("--refit", type=int, default=0,
+                   help="findings refitted on the extended model (default 0: the screen's sizes; the package's "
+                        "default is 3)")
     args = p.parse_args(argv)
     from threadpoolctl import threadpool_limits
     rows = []
@@ -212,7 +216,7 @@ def main(argv=None) -> int:
         for spec in args.cases:
             kind, seed = spec.split(":")
             for r in args.refine:
-                row = run_case(r, kind, int(seed), Path(tmp), profile=args.profile == r)
+                row = run_case(r, kind, int(seed), Path(tmp), profile=args.profile == r, refit=args.refit)
                 rows.append(row)
                 print(line(row), flush=True)
     base = {(x["kind"], x["seed"]): x for x in rows if x["r"] == min(args.refine)}

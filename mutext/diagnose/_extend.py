@@ -441,17 +441,85 @@ def _refit(f: Finding, model_text, path, eng, fit: _Data, s2, N, rss0, threshold
     frfs = [replace(c.frf, freq_hz=fs, response=m, metadata=dict(c.frf.metadata))
             for c, fs, m in zip(fit.chans, fit.freq_hz, fit.meas)]
     x0 = min(max(float(ext.values()[ext.parameter_names.index(name)]), lo), hi)
-    res = tune(ext, frfs, [name], bounds={name: (lo, hi)}, start={name: x0}, max_iter=60, progress=progress)
-    v = res.values[name]
-    rms = (res.residual_rms_db / DB_PER_NEPER) ** 2 + math.radians(res.residual_rms_deg) ** 2
-    rss = res.n_points * rms
+    on_modes = _refit_on_modes(ext, name, lo, hi, x0, h.scale, fit)
+    if on_modes is not None:
+        v, rss, jj = on_modes
+        f.std = math.sqrt(s2 / jj) if jj > 0 else math.inf
+    else:
+        res = tune(ext, frfs, [name], bounds={name: (lo, hi)}, start={name: x0}, max_iter=60, progress=progress)
+        v = res.values[name]
+        rms = (res.residual_rms_db / DB_PER_NEPER) ** 2 + math.radians(res.residual_rms_deg) ** 2
+        rss = res.n_points * rms
+        f.std = float(res.std[name]) * math.sqrt(s2) / max(res.sigma, 1e-300)
     f.value = float(v - h.nominal)
     f.new_value = None if h.added else float(v)
-    f.std = float(res.std[name]) * math.sqrt(s2) / max(res.sigma, 1e-300)
     f.delta_chi2 = float((rss0 - rss) / s2)
     f.score = rss / s2 + math.log(N)
     f.significant = bool(f.delta_chi2 > threshold)
     f.refit = True
+
+
+def _refit_on_modes(ext, name: str, lo: float, hi: float, x0: float, scale: float, fit: _Data):
+    """The one-parameter refit of :func:`_refit` on a rotor's modes: ``(value, rss, J.J)`` or None.
+
+    The objective is :func:`mutext.rotor.tuning.tune`'s (the squared complex log error of the model
+    against the data, summed over the fitted points); the model's response at each value comes from the
+    modes of its state space (:class:`mutext.diagnose._screen._Receptance`, modal damping formed again for
+    the changed stiffness and mass), one eigen-decomposition per value instead of a dense solve per
+    frequency, so the cost grows with the DOFs as the screen's does.  Bounded Gauss-Newton with a
+    forward-difference derivative and step halving.  None where the modal form does not hold (a lumped
+    chain, an impedance element, several speeds, a defective model): :func:`_refit` then calls ``tune``."""
+    from ..rotor.lumped_elements import impedances
+    from ._channels import _resolve
+    from ._screen import _NotModal, _Receptance
+    speeds = {c.speed for c in fit.chans}
+    if ext.layout.kind != "rotor" or impedances(ext) or len(speeds) != 1:
+        return None
+    speed = speeds.pop()
+    w_all = np.unique(np.concatenate([2 * np.pi * np.asarray(fs, float) for fs in fit.freq_hz]))
+    chans, _ = _resolve(ext, [c.frf for c in fit.chans], "data")
+    pos = [np.searchsorted(w_all, 2 * np.pi * np.asarray(fs, float)) for fs in fit.freq_hz]
+    i = ext.parameter_names.index(name)
+    base = ext.values()
+
+    def residual(v):
+        vals = base.copy()
+        vals[i] = v
+        rec = _Receptance(ext, vals, speed, w_all)
+        if rec.modal is None:
+            raise _NotModal
+        r = np.concatenate([np.log((rec.modal.row(w_all[p], c.out_dof) @ rec.input_vector(c.in_spec)) / m)
+                            for c, p, m in zip(chans, pos, fit.meas)])
+        return np.concatenate([r.real, r.imag])
+
+    try:
+        v, r = x0, residual(x0)
+        for _ in range(30):
+            dh = 1e-6 * max(abs(v), scale)
+            dh = -dh if v + dh > hi else dh
+            J = (residual(v + dh) - r) / dh
+            jj = float(J @ J)
+            if not (jj > 0 and np.all(np.isfinite(J))):
+                break
+            step = -float(J @ r) / jj
+            for _ in range(12):                    # halve the step until the misfit does not grow
+                v_new = min(max(v + step, lo), hi)
+                r_new = residual(v_new)
+                if float(r_new @ r_new) <= float(r @ r):
+                    break
+                step *= 0.5
+            else:
+                break
+            moved = abs(v_new - v)
+            v, r = v_new, r_new
+            if moved <= 1e-9 * max(abs(v), scale):
+                break
+        dh = 1e-6 * max(abs(v), scale)
+        dh = -dh if v + dh > hi else dh
+        J = (residual(v + dh) - r) / dh
+    except (_NotModal, np.linalg.LinAlgError, FloatingPointError):
+        return None
+    return float(v), float(r @ r), float(J @ J)
 
 
 def mbi_element(reading: dict, res, E, model_text: str, eng, station: int, dof: int, rec, held: _Data, s2: float,
