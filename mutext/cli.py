@@ -73,7 +73,8 @@ COMMANDS = {
     "rig": ("mutext.commands.rig", "virtual rig: 'rig hide' writes a data set with a hidden effect"),
     "frf": ("mutext.commands.frf", "FRF files: 'frf convert' between mutext's CSV and Universal File data set 58, "
                                    "'frf resonances' the model-free resonance table of measured FRFs"),
-    "rotor": ("mutext.commands.rotor", "rotor model files: 'rotor campbell' the Campbell diagram and critical speeds"),
+    "rotor": ("mutext.commands.rotor", "rotor model files: 'rotor campbell' the Campbell diagram and critical "
+                                       "speeds, 'rotor whirl' directional FRFs, 'rotor runup' a transient run-up"),
 }
 
 
@@ -212,14 +213,18 @@ def _main(argv=None) -> int:
         argv = ["--help"] if len(argv) == 1 else [argv[1], "--help"]
     if not argv or argv[0] in ("-h", "--help"):
         print("usage: mutext {diagnose,rig,frf,rotor,demo,check,grade,help} ...   (mutext --version)\n\n"
-              "  diagnose MODEL.toml DATA.csv [...] [--validate VAL.csv ...] [--out DIR] [--json]\n"
-              "                                     what the model gets wrong, why, and the gain once fixed\n"
+              "  diagnose MODEL.toml DATA.csv [...] [--validate VAL.csv ...] [--repeat AT_OTHER_LEVEL.csv ...]\n"
+              "           [--out DIR] [--json]      what the model gets wrong, why, and the gain once fixed\n"
               "  diagnose --batch DIR [--jobs N]    every data set under DIR, summary.csv and index.html\n"
               "  rig hide --seed N --out DIR        a data set with a hidden effect to diagnose\n"
               "  frf convert IN OUT                 FRF file CSV <-> Universal File 58 (.csv, .uff, .unv)\n"
               "  frf resonances FILE [...] [--json] resonances of measured FRFs: f_n, damping, channels\n"
               "  rotor campbell MODEL.toml [--speeds 0:3000:31] [--plot FILE] [--json]\n"
               "                                     Campbell diagram, log decrement, 1x/2x/3x critical speeds\n"
+              "  rotor whirl MODEL.toml --input I --output O [--speed RPM]\n"
+              "                                     forward and backward whirl peaks (directional FRFs)\n"
+              "  rotor runup MODEL.toml --unbalance STATION:KG:M --speeds START:STOP --duration S --output STATION\n"
+              "                                     transient run-up or coast-down through the critical speeds\n"
               "  demo NAME [options]                run a demonstration (mutext demo --list)\n"
               "  check EXERCISE FILE [--json]       does your exercise file run and return the right kinds of\n"
               "                                     values? (never whether they are right; mutext check --list)\n"

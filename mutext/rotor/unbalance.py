@@ -26,8 +26,9 @@ amplitude peaks and the phase falls by about 180 degrees.
 speed is this same solve when the speed changes slowly compared with the
 decay of the modes (the quasi-steady run-up); :func:`run_up` returns it
 for a sweep of speeds in either direction.  A fast run-up shifts and
-lowers the peak (Friswell et al. 2010, sec. 3.7); that transient is not
-modelled here.
+lowers the peak (Friswell et al. 2010, sec. 3.7): that transient is
+:func:`mutext.rotor.transient.transient_run_up` (the equations of motion
+integrated in time through the critical speeds).
 
 For the Jeffcott rotor (a disk of mass :math:`m` on a shaft of stiffness
 :math:`k` and damping :math:`c`) this is
