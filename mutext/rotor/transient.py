@@ -319,6 +319,80 @@ def _basis(M, K, n_modes, cutoff, loads, static_correction):
     return T @ Psi, np.maximum(lr, 0.0)
 
 
+def _checked_run(model, name, speeds, duration, acceleration, modes, steps_per_rev, initial, dt, steps):
+    """The run's options checked (a named ModelError for each), as ``(start, stop, duration)``."""
+    if getattr(getattr(model, "layout", None), "kind", "") != "rotor":
+        raise ModelError(f"{name!r}: a run-up needs a rotor with two bending planes (planes = 2)")
+    try:
+        w0, w1 = speeds
+    except (TypeError, ValueError):
+        raise ModelError(f"{name}: speeds must be (start, stop) in rad/s, got {speeds!r}") from None
+    w0 = _finite_number(w0, f"{name}: the start speed", "rad/s")
+    w1 = _finite_number(w1, f"{name}: the stop speed", "rad/s")
+    if w0 < 0 or w1 < 0:
+        raise ModelError(f"{name}: speeds must be non-negative (rad/s), got ({w0}, {w1})")
+    if (duration is None) == (acceleration is None):
+        raise ModelError(f"{name}: give either duration (s) or acceleration (rad/s^2), not both or neither")
+    if duration is not None:
+        T = _finite_number(duration, f"{name}: duration", "s")
+        if T <= 0:
+            raise ModelError(f"{name}: duration must be positive (s), got {T!r}")
+    else:
+        a = _finite_number(acceleration, f"{name}: acceleration", "rad/s^2")
+        if a <= 0:
+            raise ModelError(f"{name}: acceleration must be positive (rad/s^2, its sign follows the speeds), "
+                             f"got {a!r}")
+        if w0 == w1:
+            raise ModelError(f"{name}: at a constant speed give the duration, not an acceleration")
+        T = abs(w1 - w0) / a
+    if max(w0, w1) <= 0:
+        raise ModelError(f"{name}: the rotor never turns (both speeds 0): an unbalance exerts no force")
+    if modes is not None:
+        check_param(name, "modes", modes, Integer(1, None))
+    check_param(name, "steps_per_rev", steps_per_rev, Integer(8, None))
+    if initial not in ("steady", "rest"):
+        raise ModelError(f"{name}: initial must be 'steady' or 'rest', got {initial!r}")
+    if dt is not None and steps is not None:
+        raise ModelError(f"{name}: give dt or steps, not both")
+    if steps is not None:
+        check_param(name, "steps", steps, Integer(1, None))
+    if dt is not None:
+        dt = _finite_number(dt, f"{name}: dt", "s")
+        if dt <= 0:
+            raise ModelError(f"{name}: dt must be positive (s), got {dt!r}")
+    return w0, w1, T
+
+
+def _newmark(q, qd, qdd, lam, Cr, Gr, h, n, force, theta, speed, const, report):
+    """Newmark's average-acceleration steps of the reduced equations (``C + Omega G`` at the new step):
+    the reduced displacements at every step, ``(n + 1, len(q))``."""
+    nr = q.size
+    beta, gamma = 0.25, 0.5
+    H = np.empty((n + 1, nr))
+    H[0] = q
+    A0 = np.eye(nr) + gamma * h * Cr + np.diag(beta * h * h * lam)
+    Gh = gamma * h * Gr
+    if const:
+        lu = sla.lu_factor(A0 + speed[0] * Gh)
+    chunk = 4096
+    tick = max(1, n // 100)
+    for k0 in range(1, n + 1, chunk):
+        k1 = min(n + 1, k0 + chunk)
+        Fk = force(theta[k0:k1], speed[k0:k1])
+        for i, k in enumerate(range(k0, k1)):
+            om = speed[k]
+            xp = q + h * qd + (0.5 - beta) * h * h * qdd
+            vp = qd + (1 - gamma) * h * qdd
+            rhs = Fk[i] - Cr @ vp - om * (Gr @ vp) - lam * xp
+            qdd = sla.lu_solve(lu, rhs) if const else np.linalg.solve(A0 + om * Gh, rhs)
+            q = xp + beta * h * h * qdd
+            qd = vp + gamma * h * qdd
+            H[k] = q
+            if k % tick == 0:
+                report("integrate", k / n)
+    return H
+
+
 def transient_run_up(model, speeds, unbalance, outputs, *, duration: float | None = None,
                      acceleration: float | None = None, modes: int | None = None, static_correction: bool = True,
                      steps_per_rev: int = 128, dt: float | None = None, steps: int | None = None,
@@ -372,49 +446,13 @@ def transient_run_up(model, speeds, unbalance, outputs, *, duration: float | Non
     (1, 100.0)
     """
     name = getattr(model, "name", repr(model))
-    if getattr(getattr(model, "layout", None), "kind", "") != "rotor":
-        raise ModelError(f"{name!r}: a run-up needs a rotor with two bending planes (planes = 2)")
-    try:
-        w0, w1 = speeds
-    except (TypeError, ValueError):
-        raise ModelError(f"{name}: speeds must be (start, stop) in rad/s, got {speeds!r}") from None
-    w0 = _finite_number(w0, f"{name}: the start speed", "rad/s")
-    w1 = _finite_number(w1, f"{name}: the stop speed", "rad/s")
-    if w0 < 0 or w1 < 0:
-        raise ModelError(f"{name}: speeds must be non-negative (rad/s), got ({w0}, {w1})")
-    if (duration is None) == (acceleration is None):
-        raise ModelError(f"{name}: give either duration (s) or acceleration (rad/s^2), not both or neither")
-    if duration is not None:
-        T = _finite_number(duration, f"{name}: duration", "s")
-        if T <= 0:
-            raise ModelError(f"{name}: duration must be positive (s), got {T!r}")
-    else:
-        a = _finite_number(acceleration, f"{name}: acceleration", "rad/s^2")
-        if a <= 0:
-            raise ModelError(f"{name}: acceleration must be positive (rad/s^2, its sign follows the speeds), "
-                             f"got {a!r}")
-        if w0 == w1:
-            raise ModelError(f"{name}: at a constant speed give the duration, not an acceleration")
-        T = abs(w1 - w0) / a
+    w0, w1, T = _checked_run(model, name, speeds, duration, acceleration, modes, steps_per_rev, initial, dt, steps)
+    if dt is not None:
+        dt = float(dt)
     alpha = (w1 - w0) / T
     wmax = max(w0, w1)
-    if wmax <= 0:
-        raise ModelError(f"{name}: the rotor never turns (both speeds 0): an unbalance exerts no force")
     ub = _unbalance_list(model, unbalance)
     outs = _outputs(model, outputs)
-    if modes is not None:
-        check_param(name, "modes", modes, Integer(1, None))
-    check_param(name, "steps_per_rev", steps_per_rev, Integer(8, None))
-    if initial not in ("steady", "rest"):
-        raise ModelError(f"{name}: initial must be 'steady' or 'rest', got {initial!r}")
-    if dt is not None and steps is not None:
-        raise ModelError(f"{name}: give dt or steps, not both")
-    if steps is not None:
-        check_param(name, "steps", steps, Integer(1, None))
-    if dt is not None:
-        dt = _finite_number(dt, f"{name}: dt", "s")
-        if dt <= 0:
-            raise ModelError(f"{name}: dt must be positive (s), got {dt!r}")
     v = _values(model, values)
     report = progress if callable(progress) else (lambda stage, fraction: None)
 
@@ -477,31 +515,7 @@ def transient_run_up(model, speeds, unbalance, outputs, *, duration: float | Non
         f0 = force(theta[:1], speed[:1])[0]
         qdd = f0 - (Cr + w0 * Gr) @ qd - lam * q
 
-        # ------------------------------------------------------------- Newmark, average acceleration
-        beta, gamma = 0.25, 0.5
-        H = np.empty((n + 1, nr))
-        H[0] = q
-        A0 = np.eye(nr) + gamma * h * Cr + np.diag(beta * h * h * lam)
-        Gh = gamma * h * Gr
-        const = alpha == 0.0
-        if const:
-            lu = sla.lu_factor(A0 + w0 * Gh)
-        chunk = 4096
-        tick = max(1, n // 100)
-        for k0 in range(1, n + 1, chunk):
-            k1 = min(n + 1, k0 + chunk)
-            Fk = force(theta[k0:k1], speed[k0:k1])
-            for i, k in enumerate(range(k0, k1)):
-                om = speed[k]
-                xp = q + h * qd + (0.5 - beta) * h * h * qdd
-                vp = qd + (1 - gamma) * h * qdd
-                rhs = Fk[i] - Cr @ vp - om * (Gr @ vp) - lam * xp
-                qdd = sla.lu_solve(lu, rhs) if const else np.linalg.solve(A0 + om * Gh, rhs)
-                q = xp + beta * h * h * qdd
-                qd = vp + gamma * h * qdd
-                H[k] = q
-                if k % tick == 0:
-                    report("integrate", k / n)
+        H = _newmark(q, qd, qdd, lam, Cr, Gr, T / n, n, force, theta, speed, alpha == 0.0, report)
         if not np.all(np.isfinite(H[-1])):
             raise ModelError(f"{name}: the run-up response is not finite (an unstable rotor at these speeds?)")
         iu = [lay.dof(s, "u") for s in outs]
