@@ -1,10 +1,12 @@
-"""Static checks of the package's source: no name is used that is not defined (pyflakes).
+"""Static checks of the package's source: no name is used that is not defined (pyflakes), and no module
+or function grows past the sizes one reader can hold.
 
 A name left behind when code moves between modules is found only when that line runs; this finds it
 before (a method of a result class that no default test calls was such a case).
 """
 from __future__ import annotations
 
+import ast
 from pathlib import Path
 
 import pytest
@@ -49,3 +51,49 @@ def test_the_check_finds_an_undefined_name(tmp_path):
     f.write_text("import numpy as np\n\n\ndef error(T):\n    return as_ss(T)\n")
     found = [x for x in _messages([f]) if isinstance(x, m.UndefinedName)]
     assert len(found) == 1 and "as_ss" in str(found[0])
+
+
+#: Largest module (lines) and function (lines of code, its docstring not counted).
+MODULE_LINES, FUNCTION_LINES = 800, 120
+
+
+def code_lines(node) -> int:
+    """Lines of a function without its docstring."""
+    n = node.end_lineno - node.lineno + 1
+    first = node.body[0] if node.body else None
+    if isinstance(first, ast.Expr) and isinstance(first.value, ast.Constant) and isinstance(first.value.value, str):
+        n -= first.end_lineno - first.lineno + 1
+    return n
+
+
+def oversized(paths, root=PACKAGE):
+    """``path: what`` for each module over :data:`MODULE_LINES` lines and function over :data:`FUNCTION_LINES`
+    lines of code."""
+    out = []
+    for p in paths:
+        text = p.read_text(encoding="utf-8")
+        rel = p.relative_to(root.parent).as_posix()
+        if len(text.splitlines()) > MODULE_LINES:
+            out.append(f"{rel}: {len(text.splitlines())} lines")
+        for node in ast.walk(ast.parse(text)):
+            if isinstance(node, (ast.FunctionDef, ast.AsyncFunctionDef)) and code_lines(node) > FUNCTION_LINES:
+                out.append(f"{rel}:{node.lineno}: {node.name} has {code_lines(node)} lines of code")
+    return out
+
+
+def test_no_module_or_function_too_long():
+    bad = oversized(sorted(PACKAGE.rglob("*.py")))
+    assert not bad, (f"split these (modules up to {MODULE_LINES} lines, functions up to {FUNCTION_LINES} lines of "
+                     "code):\n" + "\n".join(bad))
+
+
+def test_size_check_counts_code_not_docstrings(tmp_path):
+    body = "\n".join(f"    x{i} = {i}" for i in range(FUNCTION_LINES))
+    doc = '    """' + "\n".join(["doc"] * 30) + '"""\n'
+    (tmp_path / "mutext").mkdir()
+    ok = tmp_path / "mutext" / "ok.py"
+    ok.write_text("def f():\n" + doc + body[:body.rindex("\n")] + "\n")
+    long = tmp_path / "mutext" / "long.py"
+    long.write_text("def g():\n" + body + "\n    return x0\n")
+    assert oversized([ok, long], tmp_path / "mutext") == [
+        f"mutext/long.py:1: g has {FUNCTION_LINES + 2} lines of code"]
