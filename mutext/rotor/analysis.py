@@ -268,7 +268,7 @@ def modes(model, *, speed: float | None = None, values=None, n: int | None = Non
         ``"sparse"``: the ``n`` lowest by shift-invert Arnoldi on the sparse pencil
         (:mod:`mutext.rotor.sparse_modal`; needs ``n``, a nonsingular stiffness
         matrix and raises if ARPACK does not converge); ``"auto"``: sparse
-        when it pays -- ``n`` given, at least 400 DOFs, ``2n + 8`` at most a tenth of
+        when it pays -- ``n`` given, at least 150 DOFs, ``2n + 8`` at most a fifth of
         them, banded mass and damping matrices (not modal damping, which is dense)
         and a positive definite stiffness matrix (no rigid-body mode) -- falling
         back to dense if the sparse solve fails.  Both give the same modes (to
@@ -377,7 +377,7 @@ def _as_modes(model, ev, shapes, speed) -> Modes:
 def _sparse_pays(M, D, K, n: int) -> bool:
     """Whether a shift-invert solve for ``n`` modes beats the dense one and is safe: see :func:`modes`."""
     N = M.shape[0]
-    if N < 400 or 2 * n + 8 > N // 10:
+    if N < 150 or 2 * n + 8 > N // 5:
         return False
     if np.count_nonzero(M) > 0.05 * N * N or np.count_nonzero(D) > 0.05 * N * N:
         return False
