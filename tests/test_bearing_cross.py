@@ -1,9 +1,9 @@
 """A bearing's cross-coupled stiffness: the model file's kxy/kyx, and the diagnosis kind that finds it.
 
 Default run: the [[bearing]] keys read, written and read back, the sign convention (force = -K q, kxy
-the x-y entry of the bearing block), bad values named; the hypothesis offered only with data that cross
-the bending planes; its change of dynamic stiffness against the model file's own (the extended file
-read back, its matrices' difference).  Slow: the hidden effect found on two-plane data of the plain
+the x-y entry of the bearing block), bad values named; the hypothesis at every bearing of a two-plane
+rotor; its change of dynamic stiffness against the model file's own (the extended file read back, its
+matrices' difference).  Slow: the hidden effect found on two-plane data of the plain
 rotor of tests/rotor_plain.py (written apart from mutext.rotor), the extended model read back and
 compared with the data's response.
 """
@@ -18,7 +18,6 @@ import numpy as np
 import pytest
 
 from mutext.diagnose import diagnose
-from mutext.diagnose._channels import _resolve
 from mutext.diagnose._extend import extended_model_text
 from mutext.diagnose._hypotheses import hypotheses
 from mutext.diagnose._result import Finding
@@ -144,23 +143,26 @@ def test_bad_cross_coupling_values_are_named():
         loads_model(_bearing(ROTOR, k_xy=1.0), source="small.toml")
 
 
-def test_offered_only_when_a_channel_crosses_the_planes():
+def test_offered_at_every_bearing_of_a_two_plane_rotor():
     model = loads_model(ROTOR, source="small.toml")
-    kinds = lambda frfs: [(h.station, h.element) for h in hypotheses(model, frfs)         # noqa: E731
-                          if h.kind == "cross_coupling"]
-    assert kinds(None) == []
-    assert kinds([_frf(3, "x"), _frf(3, "y", "y")]) == []           # both planes, none across
-    both = [(1, "bearing1"), (5, "right")]
-    assert kinds([_frf(3, "x"), _frf(3, "y")]) == both             # x in, y out
-    assert kinds([_frf(3, "x", "y")]) == both                      # y in, x out
+    found = lambda m, frfs=None: [(h.station, h.element, tuple(h.dofs)) for h in hypotheses(m, frfs)   # noqa: E731
+                                  if h.kind == "cross_coupling"]
+    lay = model.layout
+    both = [(1, "bearing1", (lay.dof(1, "u"), lay.dof(1, "v"))), (5, "right", (lay.dof(5, "u"), lay.dof(5, "v")))]
+    assert found(model) == both
+    assert found(model, [_frf(3, "x")]) == both          # x-only data too: the screen's test decides
+    one_plane = ROTOR.replace("planes = 2", "planes = 1").replace("speed_rpm = 600", "speed_rpm = 0")
+    one_plane = one_plane.replace('[[force]]\nstation = 3\ndirection = "y"\n', "").replace(
+        '[[sensor]]\nstation = 3\ndirection = "y"\n', "")
+    one = loads_model(one_plane, source="one plane")
+    assert found(one) == []
 
 
 def test_change_of_dynamic_stiffness_is_the_model_files():
     """The hypothesis's change on (u, v) is the difference of the dynamic stiffness of the model file
     with the written kxy/kyx and without (modal damping follows the symmetric part of K, unchanged)."""
     model = loads_model(ROTOR, source="small.toml")
-    chans, _ = _resolve(model, [_frf(3, "x"), _frf(3, "y")], "data")
-    for h in bearing_cross.candidates(model, chans):
+    for h in bearing_cross.candidates(model):
         q = 0.37 * h.scale
         assert h.added and h.lower == -h.upper and h.scale == pytest.approx(0.1 * h.upper)
         f = Finding(h.kind, h.station, h.element, q, h.unit, 0.1 * q, 0.0, 100.0, h.description, True,

@@ -174,7 +174,7 @@ def test_every_rotor_kind_is_written_and_read_back():
     model = loads_model(ROTOR, source="small.toml")
     original = tomllib.loads(ROTOR)
     hyps = [h for h in hypotheses(model) if h.gain is None and h.glob is None]
-    assert {h.kind for h in hyps} == {"bearing", "stiffness", "damping", "mass", "crack"}
+    assert {h.kind for h in hyps} == {"bearing", "cross_coupling", "stiffness", "damping", "mass", "crack"}
     for h in hyps:
         value = 0.21 if h.kind == "crack" else 0.37 * h.scale
         out = extended_model_text(ROTOR, _finding(h, value), model)

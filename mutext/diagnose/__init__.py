@@ -12,8 +12,7 @@ r"""Diagnosis: what a model gets wrong against measured FRFs, its cause, the fix
    station, a bearing's stiffness or damping, a crack in a shaft element
    (:mod:`~mutext.diagnose.faults.lumped`, :mod:`~mutext.diagnose.faults.rotor`,
    :mod:`~mutext.diagnose.faults.crack`), a bearing's skew cross-coupled
-   stiffness when the data cross the bending planes
-   (:mod:`~mutext.diagnose.faults.bearing_cross`), a tuned-mass absorber at a mass of
+   stiffness (:mod:`~mutext.diagnose.faults.bearing_cross`), a tuned-mass absorber at a mass of
    a chain (three parameters, :mod:`~mutext.diagnose.faults.absorber`); on
    the measurement chain a sensor's or exciter's gain (either sign), one
    file's scale (unit slips, named as such), a sensor's delay, a mass that

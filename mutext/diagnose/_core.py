@@ -19,7 +19,8 @@ from ..rotor.model import load_model, loads_model
 from ..rotor.tuning import model_response
 from ._compare import _errors, _model_modes, _resonance_table, _summary
 from ._extend import _identify_at, _refit, extended_model_text, mbi_element, write_model
-from ._hypotheses import Hypothesis, data_candidates, hypotheses
+from ._hypotheses import Hypothesis, hypotheses
+from .faults import channel as _channel
 from .faults import structure as _structure
 from ._result import ChannelComparison, Diagnosis, Finding
 from ._channels import _resolve, _src
@@ -244,7 +245,7 @@ def _what_is_wrong(d):
 def _screened(d, alpha, refit, only, notes, tell):
     """The hypotheses screened and the best few refitted on the extended model (notes on failed refits go to
     ``notes``): ``(hypotheses, number of real data N, rss of the engineering model, threshold, findings)``."""
-    hyps = hypotheses(d.eng) + data_candidates(d.eng, d.chans) + _structure.candidates(d.eng)
+    hyps = hypotheses(d.eng) + _channel.candidates(d.eng, d.chans) + _structure.candidates(d.eng)
     if only is not None:
         hyps = [h for h in hyps if only(h)]
         if not hyps:

@@ -18,7 +18,7 @@ from .faults import rotor as _rotor
 from .faults import structure as _structure
 from .faults._base import Hypothesis
 
-__all__ = ["KINDS", "Hypothesis", "hypotheses", "data_candidates", "write_finding"]
+__all__ = ["KINDS", "Hypothesis", "hypotheses", "write_finding"]
 
 #: Kinds of finding (the ``kind`` field of :class:`~mutext.diagnose.Finding`).
 KINDS = (("stiffness", "mass", "damping", "crack", "bearing") + _bearing_cross.KINDS + _absorber.KINDS
@@ -33,8 +33,7 @@ def hypotheses(model, frfs=None, *, stations=None) -> list[Hypothesis]:
     model : Structure, Rotor or str
         The engineering model, or the path of its model file.
     frfs : sequence of mutext.response.FRF, optional
-        The measured channels (adds the measurement-chain hypotheses, and a bearing's cross-coupled
-        stiffness when a channel crosses the bending planes: :func:`data_candidates`).
+        The measured channels (adds the measurement-chain hypotheses).
     stations : sequence of int, optional
         Stations at which rotor and crack hypotheses are formed (default: all).
     """
@@ -44,31 +43,12 @@ def hypotheses(model, frfs=None, *, stations=None) -> list[Hypothesis]:
         hyps = (_lumped.candidates(model) + _distributed.candidates(model) + _absorber.candidates(model)
                 + _pedestal.candidates(model))
     else:
-        hyps = _rotor.candidates(model, stations) + _crack.candidates(model, stations)
+        hyps = (_rotor.candidates(model, stations) + _bearing_cross.candidates(model, stations)
+                + _crack.candidates(model, stations))
     if frfs is not None:
         chans, _ = _resolve(model, list(frfs), "FRF")
-        hyps += data_candidates(model, chans, stations=stations)
+        hyps += _channel.candidates(model, chans)
     return hyps
-
-
-def data_candidates(model, chans, *, stations=None) -> list[Hypothesis]:
-    """The hypotheses the measured channels make testable: the measurement chain's (each channel's sensor,
-    exciter, scale, delay), and on a two-plane rotor whose data cross the planes a skew cross-coupled
-    stiffness at every bearing (:mod:`~mutext.diagnose.faults.bearing_cross`).
-
-    Parameters
-    ----------
-    model : Structure or Rotor
-        The engineering model.
-    chans : sequence
-        The measured channels resolved on ``model`` (:func:`mutext.diagnose._channels._resolve`).
-    stations : sequence of int, optional
-        Stations at which the bearing hypotheses are formed (default: all).
-    """
-    hyps = []
-    if model.layout.kind != "lumped":
-        hyps += _bearing_cross.candidates(model, chans, stations)
-    return hyps + _channel.candidates(model, chans)
 
 
 def write_finding(mf, finding, model, note: str) -> None:

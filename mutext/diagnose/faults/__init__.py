@@ -4,7 +4,7 @@ model file (:mod:`mutext.rotor.model_writer`) and described.
 :mod:`~mutext.diagnose.faults.lumped`: a chain's springs, dampers and masses changed, springs and
 dampers to ground added; :mod:`~mutext.diagnose.faults.rotor`: a rotor's bearings changed, springs,
 dampers and masses added at its stations; :mod:`~mutext.diagnose.faults.bearing_cross`: a bearing's
-skew cross-coupled stiffness (two-plane data); :mod:`~mutext.diagnose.faults.crack`: an open crack in a
+skew cross-coupled stiffness (two-plane rotors); :mod:`~mutext.diagnose.faults.crack`: an open crack in a
 shaft element; :mod:`~mutext.diagnose.faults.absorber`: a tuned-mass absorber (an added degree of
 freedom, three parameters); :mod:`~mutext.diagnose.faults.pedestal`: a spring to ground set on a
 pedestal (mass and spring, two parameters); :mod:`~mutext.diagnose.faults.distributed`: one relative
