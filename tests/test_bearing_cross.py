@@ -29,6 +29,7 @@ from mutext.rig import Noise, measure, sweep_frequencies, write_frf
 from mutext.rotor import load_model
 from mutext.rotor.model import loads_model
 from mutext.rotor.model_writer import ModelFile
+from mutext.rotor.units import to_si
 
 # a small two-plane rotor (inline stations), bearings at both ends, spinning
 ROTOR = """name = "small rotor"
@@ -188,6 +189,26 @@ def test_change_of_dynamic_stiffness_is_the_model_files():
         Hs = np.linalg.solve(Z0 + want, np.broadcast_to(b.astype(complex), (w.size, b.size))[:, :, None])
         assert np.allclose(H1, Hs[:, model.layout.dof(3, "v"), 0], rtol=1e-9, atol=0)
         assert np.max(np.abs(H1 - H0) / np.abs(H0)) > 1e-3         # the change is seen across the planes
+
+
+def test_an_existing_cross_coupling_is_changed_and_units_are_the_files():
+    text = _bearing(ROTOR, kxy=3.0e4, kyx=-1.0e4)
+    model = loads_model(text, source="small.toml")
+    h = next(h for h in hypotheses(model) if h.kind == "cross_coupling" and h.element == "right")
+    assert not h.added and h.nominal == 2.0e4 and "changed" in h.description
+    f = Finding(h.kind, h.station, h.element, 5.0e3, h.unit, 1.0, 0.0, 100.0, h.description, True, hypothesis=h)
+    entry = tomllib.loads(extended_model_text(text, f, model))["bearing"][1]
+    assert (entry["kxy"], entry["kyx"]) == (3.5e4, -1.5e4)
+    # an inch-pound file gets lbf/in
+    ip = 'units = "inch-pound"\n' + ROTOR
+    model = loads_model(ip, source="ip.toml")
+    h = next(h for h in hypotheses(model) if h.kind == "cross_coupling" and h.element == "right")
+    f = Finding(h.kind, h.station, h.element, 1.0e4, h.unit, 1.0, 0.0, 100.0, h.description, True, hypothesis=h)
+    out = extended_model_text(ip, f, model)
+    lbf_per_in = to_si(1.0, "stiffness", "inch-pound")                 # N/m
+    assert tomllib.loads(out)["bearing"][1]["kxy"] == pytest.approx(1.0e4 / lbf_per_in, rel=1e-12)
+    el = next(e for e in loads_model(out, source="back").elements if e.name == "right")
+    assert (el.nominal("kxy"), el.nominal("kyx")) == (pytest.approx(1.0e4, rel=1e-12), pytest.approx(-1.0e4, rel=1e-12))
 
 
 # ------------------------------------------------------------------------------------------------

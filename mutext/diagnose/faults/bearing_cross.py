@@ -56,7 +56,10 @@ channels (x13, x6, x24) find the kind and the size (:math:`2.01\cdot 10^5 \pm
 
 Written into the model file (:mod:`mutext.rotor.model_writer`): the
 bearing's ``kxy`` and ``kyx`` set (added when the entry has none), in the
-file's units.
+file's units.  The size is not refitted on the extended model (no single
+model parameter holds it; ``parameter`` is None): nothing there differs from
+the screen's exact fit, since modal damping follows the symmetric part of K,
+which a skew :math:`q` leaves unchanged.
 """
 from __future__ import annotations
 
