@@ -388,3 +388,60 @@ def test_diagnosis_receptance_holds_the_impedance_and_tune_refuses_it(tmp_path):
     frf = ext.frf(f, inputs=["f1"], outputs=["x1"]).channel("x1", "f1")
     with pytest.raises(ModelError, match="impedance element 'K_test'"):
         tune(ext, [frf], ["k1"])
+
+
+# ----------------------------------------------------------------------------- files in inch-pound units
+
+#: SI per inch-pound unit, from the definitions (1 in = 0.0254 m, 1 lb = 0.45359237 kg, g0 = 9.80665 m/s^2)
+LB, LBF_PER_IN = 0.45359237, 0.45359237 * 9.80665 / 0.0254
+
+
+def _inch_pound_three_mass() -> str:
+    """three_mass.toml with its numbers in lb and lbf/in, lbf s/in (converted here, not by the package)."""
+    doc = tomllib.loads(open(THREE_MASS, encoding="utf-8").read())
+    lines = [f'name = "{doc["name"]} in inch-pound"', 'units = "inch-pound"']
+    for table, key, f in (("mass", "mass", LB), ("spring", "stiffness", LBF_PER_IN),
+                          ("damper", "damping", LBF_PER_IN)):
+        for t in doc.get(table, []):
+            lines += [f"[[{table}]]", f'name = "{t["name"]}"', f"{key} = {t[key] / f!r}"]
+            if "between" in t:
+                lines.append(f"between = {t['between']!r}".replace("'", '"'))
+    for table in ("force", "sensor"):
+        for t in doc.get(table, []):
+            lines.append(f"[[{table}]]")
+            lines += [f"{k} = {v!r}".replace("'", '"') for k, v in t.items()]
+    return "\n".join(lines) + "\n"
+
+
+def test_findings_are_written_in_the_units_of_an_inch_pound_file():
+    # the diagnosis's sizes are SI; written into an inch-pound file they must read back as the same SI values
+    text = _inch_pound_three_mass()
+    model = loads_model(text, source="ip.toml")
+    si = loads_model(open(THREE_MASS, encoding="utf-8").read(), source=THREE_MASS)
+    np.testing.assert_allclose(model.values(), si.values(), rtol=1e-12)        # the file itself converts right
+    hyps = [h for h in hypotheses(model) if h.gain is None and h.glob is None and not h.run]
+    kinds = {h.kind for h in hyps}
+    assert {"stiffness", "damping", "mass", "absorber", "pedestal"} <= kinds
+    for h in hyps:
+        if h.params:                       # absorber, pedestal: several parameters, compared in the matrices
+            continue
+        value = 0.37 * h.scale
+        out = extended_model_text(text, _finding(h, value), model)
+        want = value if h.added else h.nominal + value
+        assert _value_in_file(out, h, model) == pytest.approx(want, rel=1e-12), h.label
+    for h in (h for h in hyps if h.params):
+        values = np.array([0.37 * p.scale for p in h.params])
+        f = _finding(h, float(values[0]))
+        f.values, f.stds = values, np.zeros_like(values)
+        ip = loads_model(extended_model_text(text, f, model), source="ip")
+        ref = loads_model(extended_model_text(open(THREE_MASS, encoding="utf-8").read(), f, si), source="si")
+        for a, b in zip(ip.matrices(), ref.matrices()):
+            np.testing.assert_allclose(a, b, rtol=1e-12, atol=1e-12 * np.max(np.abs(b))), h.label
+
+
+def test_si_values_need_a_known_unit():
+    mf = ModelFile('units = "inch-pound"\n[[spring]]\nname = "k1"\nstiffness = 2.0\n', source="f.toml")
+    mf.set("spring", lambda t: t["name"] == "k1", "stiffness", LBF_PER_IN * 3.0, si=True)
+    assert tomllib.loads(mf.text())["spring"][0]["stiffness"] == pytest.approx(3.0, rel=1e-14)
+    with pytest.raises(ModelError, match="no unit is known"):
+        mf.set("spring", lambda t: t["name"] == "k1", "colour", 1.0, si=True)

@@ -59,7 +59,7 @@ def extended_model_text(model_text: str, finding: Finding, model) -> str:
             return header + "# (the force input's gain: the model itself is unchanged)\n" + model_text
         mf = ModelFile(model_text)
         ki = float(model.parameter(port.gain).value) * finding.value
-        mf.set("exciter", lambda t: t.get("station") == port.node, "force_per_ampere", ki, note)
+        mf.set("exciter", lambda t: t.get("station") == port.node, "force_per_ampere", ki, note, si=True)
         return header + mf.text()
     mf = ModelFile(model_text)
     write_finding(mf, finding, model, note)
@@ -343,14 +343,14 @@ def element_model_text(model_text: str, element: dict, mass: str, host_mass: flo
     """
     mf = ModelFile(model_text)
     if element["kind"] == "mass-damper-spring":
-        mf.set("mass", lambda t: t.get("name") == mass, "mass", host_mass + element["dm"], note)
+        mf.set("mass", lambda t: t.get("name") == mass, "mass", host_mass + element["dm"], note, si=True)
         mf.append("spring", {"name": f"k_mbi_{mass}", "stiffness": element["dk"], "between": [mass, "ground"]},
-                  note)
+                  note, si=True)
         mf.append("damper", {"name": f"c_mbi_{mass}", "damping": element["dc"], "between": [mass, "ground"]},
-                  note)
+                  note, si=True)
     else:
         mf.append("impedance", {"name": f"K_mbi_{mass}", "mass": mass, "numerator": element["numerator"],
-                                "denominator": element["denominator"]}, note)
+                                "denominator": element["denominator"]}, note, si=True)
     return f"# Extended by mutext diagnose: {note}\n" + mf.text()
 
 

@@ -24,8 +24,12 @@ Three edits cover what :mod:`mutext.diagnose` writes:
 
 Every written value is a finite real number written in full precision
 (``repr`` of the float), so the model read back holds the value the caller
-gave, bit for bit.  Bad input is a :class:`~mutext.errors.ModelError` naming
-the file, the table and the key.
+gave, bit for bit.  With ``si=True`` the value is given in SI and written in
+the file's own units (``units = "inch-pound"`` files get lbf/in, lb, ...;
+:data:`QUANTITIES` says what each key of each table measures, as the reader
+converts it), so an SI result never lands unconverted in an inch-pound file.
+Bad input is a :class:`~mutext.errors.ModelError` naming the file, the table
+and the key.
 """
 from __future__ import annotations
 
@@ -37,8 +41,25 @@ from tomlkit.exceptions import TOMLKitError
 from tomlkit.items import AoT, Table
 
 from ..errors import ModelError
+from .units import from_si
 
-__all__ = ["ModelFile"]
+__all__ = ["ModelFile", "QUANTITIES"]
+
+#: What each numeric key of a model file's tables measures (:mod:`mutext.rotor.units`), as the reader
+#: converts it: the unit in which ``si=True`` values are written.  An ``[[impedance]]``'s numerator
+#: carries its unit (a stiffness); its denominator is dimensionless.
+QUANTITIES = {
+    "bearing": {"stiffness": "stiffness", "damping": "damping", "stiffness_y": "stiffness",
+                "damping_y": "damping", "kxy": "stiffness", "kyx": "stiffness"},
+    "disk": {"mass": "mass", "polar_inertia": "inertia", "transverse_inertia": "inertia", "width": "length",
+             "outer_diameter": "length", "inner_diameter": "length", "density": "density"},
+    "mass": {"mass": "mass"},
+    "spring": {"stiffness": "stiffness"},
+    "damper": {"damping": "damping"},
+    "exciter": {"force_per_ampere": "force_per_current", "negative_stiffness": "stiffness"},
+    "crack": {"depth_ratio": "dimensionless"},
+    "impedance": {"numerator": "stiffness", "denominator": "dimensionless"},
+}
 
 
 def _number(x, where: str):
@@ -106,7 +127,7 @@ class ModelFile:
         raise ModelError(f"{self.source}: '{table}' is a value, not a table")
 
     def set(self, table: str, select: Callable[[dict], bool], key: str, value: float, note: str = "",
-            k: int = 0) -> float | None:
+            k: int = 0, *, si: bool = False) -> float | None:
         """Set ``key = value`` in the ``k``-th entry of ``[[table]]`` that ``select`` accepts.
 
         The line gets the comment ``note (was OLD)`` after the comment it had; a key the entry does not
@@ -127,11 +148,13 @@ class ModelFile:
             Comment on the change (may be empty).
         k : int
             Which of the selected entries (0-based, in file order).
+        si : bool
+            ``value`` is in SI: written in the file's units (see :data:`QUANTITIES`).
 
         Returns
         -------
         float or None
-            The old value; None when the key was added.
+            The old value (in the file's units); None when the key was added.
 
         Raises
         ------
@@ -148,7 +171,7 @@ class ModelFile:
         old = t.get(key)
         if old is not None and (isinstance(old, bool) or not isinstance(old, (int, float))):
             raise ModelError(f"{where}: holds {old!r}, not a number that can be changed")
-        item = _number(value, where)
+        item = _number(self._in_file_units(value, table, key, where) if si else value, where)
         text = (note + (f" (was {old})" if old is not None else "")).strip()
         kept = old.trivia.comment.lstrip("#").strip() if old is not None else ""
         text = f"{kept} -- {text}" if kept and text else (kept or text)     # the user's comment first
@@ -157,7 +180,7 @@ class ModelFile:
         t[key] = item
         return None if old is None else float(old)
 
-    def append(self, table: str, entries: dict, note: str = "") -> None:
+    def append(self, table: str, entries: dict, note: str = "", *, si: bool = False) -> None:
         """Append a ``[[table]]`` entry holding ``entries`` (a comment line ``note`` opens it).
 
         Parameters
@@ -170,6 +193,9 @@ class ModelFile:
             coefficients of an ``[[impedance]]``) as finite floats in full precision.
         note : str
             The comment line that opens the entry (none when empty).
+        si : bool
+            The floats and number lists of ``entries`` are in SI: written in the file's units (see
+            :data:`QUANTITIES`).
 
         Raises
         ------
@@ -185,12 +211,13 @@ class ModelFile:
                 # coefficients (an [[impedance]]'s numerator): each a finite number in full precision
                 arr = tomlkit.array()
                 for j, x in enumerate(v):
-                    arr.append(_number(x.item() if hasattr(x, "item") else x, f"{where}[{j}]"))
+                    x = x.item() if hasattr(x, "item") else x
+                    arr.append(_number(self._in_file_units(x, table, key, where) if si else x, f"{where}[{j}]"))
                 new[key] = arr
             elif isinstance(v, (str, bool, list, int)):
                 new[key] = v                # names, flags, stations and counts as given
             else:
-                new[key] = _number(v, where)
+                new[key] = _number(self._in_file_units(v, table, key, where) if si else v, where)
         new.add(tomlkit.nl())
         new.trivia.indent = "\n"
         if table not in self.doc:
@@ -237,6 +264,20 @@ class ModelFile:
                     self.set(table, lambda x, t=t: x is t, key, float(v) * factor, note)
                     count += 1
         return count
+
+    def _in_file_units(self, value, table: str, key: str, where: str):
+        """An SI ``value`` of ``[[table]]``'s ``key`` in the file's units."""
+        system = str(self.doc.get("units", "SI"))
+        quantity = QUANTITIES.get(table, {}).get(key)
+        if quantity is None:
+            raise ModelError(f"{where}: no unit is known for this key, so an SI value cannot be written "
+                             f"into a file in {system} units")
+        if isinstance(value, bool) or not isinstance(value, (int, float)):
+            return value                    # refused with its own message by _number
+        try:
+            return from_si(float(value), quantity, system)
+        except ModelError as exc:
+            raise ModelError(f"{where}: {exc}") from None
 
     def text(self) -> str:
         """The edited file's text."""

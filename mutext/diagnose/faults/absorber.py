@@ -120,8 +120,8 @@ def write(mf, finding, model, note: str) -> None:
     ma, ka, ca = (float(x) for x in finding.values)
     host = model.layout.node_names[h.station - 1]
     name = h.element
-    mf.append("mass", {"name": name, "mass": ma}, note)
+    mf.append("mass", {"name": name, "mass": ma}, note, si=True)
     mf.append("spring", {"name": f"k_{name}", "stiffness": ka, "between": [host, name]},
-              f"the spring of {name}")
+              f"the spring of {name}", si=True)
     mf.append("damper", {"name": f"c_{name}", "damping": ca, "between": [host, name]},
-              f"the damper of {name}")
+              f"the damper of {name}", si=True)

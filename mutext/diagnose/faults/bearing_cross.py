@@ -66,7 +66,6 @@ from __future__ import annotations
 import numpy as np
 
 from ...rotor.elements import BearingElement
-from ...rotor.units import from_si
 from ._base import Hypothesis
 
 KINDS = ("cross_coupling",)
@@ -134,9 +133,8 @@ def write(mf, finding, model, note: str) -> None:
     q = float(finding.value)
     el = next(e for e in model.elements if isinstance(e, BearingElement) and e.name == h.element)
     kxy, kyx = _cross(el)
-    units = str(mf.doc.get("units", "SI"))
 
     def select(t):
         return str(t.get("name") or f"bearing{t.get('station')}") == h.element
-    mf.set("bearing", select, "kxy", from_si(kxy + q, "stiffness", units), note)
-    mf.set("bearing", select, "kyx", from_si(kyx - q, "stiffness", units), note)
+    mf.set("bearing", select, "kxy", kxy + q, note, si=True)
+    mf.set("bearing", select, "kyx", kyx - q, note, si=True)

@@ -85,4 +85,4 @@ def write(mf, finding, model, note: str) -> None:
     note : str
         Comment written next to the change in the file.
     """
-    mf.append("crack", {"station": finding.hypothesis.station, "depth_ratio": float(finding.value)}, note)
+    mf.append("crack", {"station": finding.hypothesis.station, "depth_ratio": float(finding.value)}, note, si=True)

@@ -119,4 +119,5 @@ def write(mf, finding, model, note: str) -> None:
     f = 1.0 + float(finding.value)
     for name in h.run:
         el = next(e for e in model.elements if isinstance(e, Spring) and e.name == name)
-        mf.set("spring", lambda t, name=name: t.get("name") == name, "stiffness", f * el.nominal("k"), note)
+        mf.set("spring", lambda t, name=name: t.get("name") == name, "stiffness", f * el.nominal("k"), note,
+               si=True)

@@ -111,7 +111,7 @@ def write(mf, finding, model, note: str) -> None:
     table, key = TABLE[h.kind]
     if h.added:
         mf.append(table, {"name": h.element, key: float(finding.value),
-                          "between": [model.layout.node_names[h.station - 1], "ground"]}, note)
+                          "between": [model.layout.node_names[h.station - 1], "ground"]}, note, si=True)
         return
     new = finding.new_value if finding.new_value is not None else h.nominal + finding.value
-    mf.set(table, lambda t: t.get("name") == h.element, key, float(new), note)
+    mf.set(table, lambda t: t.get("name") == h.element, key, float(new), note, si=True)

@@ -106,8 +106,8 @@ def write(mf, finding, model, note: str) -> None:
     mp, kp = (float(x) for x in finding.values)
     host = model.layout.node_names[h.station - 1]
     ped = f"pedestal_{h.element}"
-    mf.append("mass", {"name": ped, "mass": mp}, note)
+    mf.append("mass", {"name": ped, "mass": mp}, note, si=True)
     entry = next(t for t in mf.entries("spring") if t.get("name") == h.element)
     entry["between"] = [host, ped]
     mf.append("spring", {"name": f"k_{ped}", "stiffness": kp, "between": [ped, "ground"]},
-              f"the spring of {ped} to ground")
+              f"the spring of {ped} to ground", si=True)

@@ -93,12 +93,14 @@ def write(mf, finding, model, note: str) -> None:
     if h.kind == "bearing":
         key = "stiffness" if h.order == 0 else "damping"
         new = finding.new_value if finding.new_value is not None else h.nominal + v
-        mf.set("bearing", lambda t: t.get("station") == h.station, key, float(new), note)
+        mf.set("bearing", lambda t: t.get("station") == h.station, key, float(new), note, si=True)
     elif h.kind == "stiffness":
-        mf.append("bearing", {"name": h.element, "station": h.station, "stiffness": v, "damping": 0.0}, note)
+        mf.append("bearing", {"name": h.element, "station": h.station, "stiffness": v, "damping": 0.0}, note,
+                  si=True)
     elif h.kind == "damping":
-        mf.append("bearing", {"name": h.element, "station": h.station, "stiffness": 0.0, "damping": v}, note)
+        mf.append("bearing", {"name": h.element, "station": h.station, "stiffness": 0.0, "damping": v}, note,
+                  si=True)
     elif h.kind == "mass":
-        mf.append("disk", {"name": h.element, "station": h.station, "mass": v}, note)
+        mf.append("disk", {"name": h.element, "station": h.station, "mass": v}, note, si=True)
     else:
         raise ValueError(f"not a rotor element kind: {h.kind}")
