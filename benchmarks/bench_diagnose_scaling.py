@@ -60,10 +60,22 @@ run), the model's assembly and modes in :mod:`mutext.rotor` (peak 4 / 14 / 52 MB
 gains of the rotor diagnoses agree with the dense inverse's to 1.4e-9 relative; lumped chains keep the
 dense inverse (identical results).
 
-Not included above: the refit of the best findings on the extended model file (``refit=3``, the default),
-:func:`mutext.rotor.tuning.tune` on the finite-element model with a dense solve per frequency.  With it,
-the crack: 30 stations 50.5 s (refit 22.8 s), 15.5 MB; 59 stations 136.2 s (refit 70.4 s), 37.1 MB: x2.70
-CPU, x2.39 memory -- the refit alone grows x3.1.
+With the refit of the best findings on the extended model file (``refit=3``, the package's default;
+``--refit 3``).  Before, the refit was :func:`mutext.rotor.tuning.tune` on the finite-element model with a
+dense solve per frequency: the crack at 30 stations 50.5 s (refit 22.8 s), 15.5 MB; 59 stations 136.2 s
+(refit 70.4 s), 37.1 MB: x2.70 CPU, x2.39 memory -- the refit alone grew x3.1.  Now a rotor's refit
+evaluates the extended model on its modes (``mutext.diagnose._extend._refit_on_modes``: the same
+objective, one eigen-decomposition per value; sizes equal to tune's to 1.3e-4 of a std):
+
+========  =====  ====  ======  =======  ==============================
+stations  DOFs   hyps  CPU s   peak MB  verdict (size +/- std)
+========  =====  ====  ======  =======  ==============================
+30        120    130   35.4    14.2     crack at 21 (0.279 +/- 0.00012)
+59        236    246   75.6    34.9     crack at 42 (0.279 +/- 0.00011)
+========  =====  ====  ======  =======  ==============================
+
+59 / 30 stations: CPU x2.13, memory x2.46 (goal: within x2.5).  Measured on a machine running other
+work on both cores (the 30-station diagnosis with the tune refit took 53.7 s in the same session).
 """
 from __future__ import annotations
 
