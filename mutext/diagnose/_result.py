@@ -445,6 +445,9 @@ class Diagnosis:
                     f"a/D {ti['depth_ratio']:.4g}); misfit left {b['misfit_left']:.3g}")
             if b["delta_chi2_vs_time_invariant"] is not None:
                 line += f", delta chi2 {b['delta_chi2_vs_time_invariant']:.1f} over the time-invariant crack"
+            if b.get("truncation_error") is not None:
+                # the fit's harmonic balance keeps 6 harmonics: its own model error, beside the misfit
+                line += f"; harmonic-balance truncation error {b['truncation_error']:.2g} of the peak"
             out.append(line)
             he = b["held_out_error"]
             tie = ti.get("held_out_error")
