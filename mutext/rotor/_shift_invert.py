@@ -5,7 +5,8 @@ r"""The underdamped roots nearest a frequency by shift-invert Arnoldi on the spa
     = \lambda \begin{bmatrix} I & 0\\ 0 & M\end{bmatrix} x ,\qquad x = [q;\ \lambda q],
 
 solved by ``scipy.sparse.linalg.eigs`` with the shift :math:`\sigma = 2\pi j f_s`: one
-sparse LU factorisation of :math:`A - \sigma B` and a few dozen solves.  Used by
+sparse LU factorisation of :math:`A - \sigma B` and a few dozen solves (systems of at most
+:data:`SMALL` states by a dense eigen-solve instead).  Used by
 :func:`mutext.rotor.sparse_modal.sparse_modes` and, for a few modes of a fine mesh, by
 :func:`mutext.rotor.analysis.modes`.
 """
@@ -14,6 +15,9 @@ from __future__ import annotations
 import numpy as np
 
 from ..errors import ModelError
+
+#: Systems of at most this many states are solved densely: Arnoldi gains nothing there.
+SMALL = 200
 
 
 def shift_invert_roots(M, K, D, n: int, shift_hz: float, extra: int, name: str):
@@ -33,6 +37,15 @@ def shift_invert_roots(M, K, D, n: int, shift_hz: float, extra: int, name: str):
     A = sp.bmat([[None, sp.identity(N)], [-Ks, -Ds]], format="csc")
     B = sp.bmat([[sp.identity(N), None], [None, Ms]], format="csc")
     sigma = 2j * np.pi * shift_hz if shift_hz else 0.0
+    if 2 * N <= SMALL:
+        # a small system: every root of M^-1 [K D] in first-order form by the balanced dense eigen-solve,
+        # faster than Arnoldi there and never unconverged (as mutext.rotor.analysis does)
+        Minv = np.linalg.inv(M)
+        lam, X = np.linalg.eig(np.block([[np.zeros((N, N)), np.eye(N)], [-Minv @ K, -Minv @ D]]))
+        if np.any(np.abs(lam - sigma) <= 1e-9 * np.max(np.abs(lam), initial=1.0)):
+            raise ModelError(f"{name}: A - sigma B is singular at shift_hz = {shift_hz:g}; a model with "
+                             "rigid-body modes needs a nonzero shift_hz")
+        return _nearest(lam, X[:N], M, K, D, n, shift_hz)
     try:
         # a fixed start vector: the same modes to the last digit on every call (ARPACK's own start is random)
         v0 = np.random.default_rng(0).standard_normal(2 * N)
@@ -43,7 +56,11 @@ def shift_invert_roots(M, K, D, n: int, shift_hz: float, extra: int, name: str):
     except RuntimeError as exc:          # singular A - sigma B (a rigid-body mode at the shift)
         raise ModelError(f"{name}: A - sigma B is singular at shift_hz = {shift_hz:g} ({exc}); a model "
                          "with rigid-body modes needs a nonzero shift_hz") from None
-    Q = X[:N]
+    return _nearest(lam, X[:N], M, K, D, n, shift_hz)
+
+
+def _nearest(lam, Q, M, K, D, n, shift_hz):
+    """The underdamped roots of ``lam`` (shapes ``Q``) nearest ``shift_hz``, at most ``n``, by frequency."""
     keep = lam.imag > 0
     lam, Q = lam[keep], Q[:, keep]
     Dsym = 0.5 * (D + D.T)
