@@ -14,10 +14,10 @@ import numpy as np
 from ...errors import ModelError
 from ...response import FRFMatrix
 from ._balance import HarmonicResponse, _freqs, _harmonic_balance, _harmonics
-from ._model import PeriodicRotor, _as_periodic
+from ._model import _as_periodic
+from ._truncation import _check_options, _warn_unconverged, analyzer_truncation
+from ._window import ANALYZER, _correlated, _settle
 
-#: The thesis's sweep settings (sec. 4.3): 0.1 A, 40 revolutions per correlation, 700 ms settling.
-ANALYZER = {"amplitude": 0.1, "revolutions": 40, "settle_s": 0.7}
 
 
 def harmonic_response(model, freqs_hz, *, harmonics: int = 6, inputs=None, outputs=None) -> HarmonicResponse:
@@ -43,42 +43,6 @@ def harmonic_response(model, freqs_hz, *, harmonics: int = 6, inputs=None, outpu
     t0 = time.perf_counter()
     pr = _as_periodic(model, inputs, outputs)
     return _harmonic_balance(pr, _freqs(freqs_hz), _harmonics(harmonics), t0)
-
-
-def _window_average(nu, t_start, T):
-    """(1/T) * integral of exp(j nu t) over [t_start, t_start + T]."""
-    nu = np.asarray(nu, float)
-    small = np.abs(nu * T) < 1e-9
-    safe = np.where(small, 1.0, nu)
-    val = np.exp(1j * safe * t_start) * (np.exp(1j * safe * T) - 1.0) / (1j * safe * T)
-    return np.where(small, np.exp(1j * nu * t_start), val)
-
-
-def _settle(pr: PeriodicRotor, settle_s: float, revolutions: int):
-    if not (np.isfinite(settle_s) and settle_s >= 0):
-        raise ModelError(f"settle_s must be a non-negative time [s], got {settle_s!r}")
-    if isinstance(revolutions, bool) or not isinstance(revolutions, (int, np.integer)) or revolutions < 1:
-        raise ModelError(f"revolutions must be a positive integer, got {revolutions!r}")
-    if not pr.speed > 0:
-        raise ModelError(f"{pr.name}: the analyzer correlates over whole revolutions; the rotor does not "
-                         "turn (speed 0)")
-    return float(settle_s), revolutions * pr.period
-
-
-def _correlated(pr: PeriodicRotor, hr: HarmonicResponse, k: int, t_s: float, T: float,
-                excitation_phase: float, descending: bool = False) -> FRFMatrix:
-    r"""The analyzer's response at order ``k`` (module docstring): :math:`\hat H_k = H_k +
-    e^{-2j\varphi}\sum_{k'}\overline{H_{k'}}\,\langle e^{-j(2\omega + (k+k')\Omega)t}\rangle` over
-    the window :math:`[t_s, t_s + T]`, :math:`k'` over all the orders of ``hr``; ``k = 0`` is
-    :math:`\hat H`.  The sum runs up the orders :math:`k'`, or down them with ``descending`` (the
-    order :func:`analyzer_frf` has always summed in, kept for its results to the last bit)."""
-    w = 2 * np.pi * hr.freqs_hz
-    N = hr.harmonics
-    H = hr(k).copy()
-    for kp in (range(N, -N - 1, -1) if descending else range(-N, N + 1)):
-        avg = _window_average(-(2 * w + (k + kp) * pr.speed), t_s, T)
-        H += np.exp(-2j * excitation_phase) * np.conj(hr(kp)) * avg
-    return FRFMatrix(hr.freqs_hz, H, list(pr.inputs), list(pr.outputs), pr.speed, dict(pr.ports))
 
 
 def analyzer_frf(model, freqs_hz, *, harmonics: int | str = 6, revolutions: int = ANALYZER["revolutions"],
@@ -148,7 +112,6 @@ def _auto(where, model, freqs_hz, orders, harmonics, tol, max_harmonics, revolut
           excitation_phase, inputs, outputs) -> dict:
     """The responses ``{k: FRFMatrix}`` of :func:`analyzer_truncation` for ``where``, warning when
     the cap stopped the automatic truncation before its tolerance."""
-    from ._truncation import _check_options, _warn_unconverged, analyzer_truncation
     _check_options(harmonics, tol, max_harmonics, where)
     res = analyzer_truncation(model, freqs_hz, harmonics=harmonics, tol=tol, max_harmonics=max_harmonics,
                               orders=orders, revolutions=revolutions, settle_s=settle_s,

@@ -11,7 +11,7 @@ import numpy as np
 
 from ...errors import ModelError
 from ...lti import blas_single_thread
-from ._analyzer import ANALYZER, _settle
+from ._window import ANALYZER, _settle
 from ._balance import _freqs
 from ._model import PeriodicRotor, periodic_rotor
 

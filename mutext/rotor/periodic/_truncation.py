@@ -46,9 +46,9 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ...errors import ModelError
-from ._analyzer import ANALYZER, _correlated, _settle
 from ._balance import _crack_range, _freqs, _harmonic_balance, _harmonic_balance_lowrank, _harmonics
 from ._model import PeriodicRotor, _as_periodic
+from ._window import ANALYZER, _correlated, _settle
 
 #: The automatic truncation's defaults: relative tolerance, the largest N, and the first N.
 AUTO = {"tol": 1e-4, "max_harmonics": 512, "start": 2}
