@@ -139,9 +139,16 @@ def _select_more(effects, hyps, rec, fit, held, s2, N, threshold, alpha, ref, no
             # an effect on one fitted file only (its scale) cannot show on other files: not held against them
             own_file_only = held_new == held_a and h.kind == "channel_scale"
             ok = dchi / left > threshold and (dheld > chi_held or own_file_only) and not stuck
-            tried.append((not ok, rss_new, h, th, sd, dchi, dheld, stuck, left, hs))
+            tried.append((not ok, rss_new, h, th, sd, dchi, dheld, stuck, left, hs, held_new))
         tried.sort(key=lambda x: (x[0], x[1]))
-        failed, rss_new, h, th, sd, dchi, dheld, stuck, left, hs = tried[0]
+        if not tried[0][0]:
+            # candidates the fitted data cannot tell apart (within one unit of chi2: a sensor's gain and the
+            # scale of the one fitted file it is in) are decided by the held-out data
+            level = [x for x in tried if not x[0] and (x[1] - tried[0][1]) / s2 < 1.0]
+            best = min(level, key=lambda x: x[10])
+            tried.remove(best)
+            tried.insert(0, best)
+        failed, rss_new, h, th, sd, dchi, dheld, stuck, left, hs, _ = tried[0]
         if failed:
             why = ("a size at the bound of its range: " + ", ".join(stuck)) if stuck else (
                 f"delta chi2 {dchi:.1f} on the fitted data (threshold {threshold:.1f}"
