@@ -20,6 +20,13 @@ from ..errors import ModelError
 SMALL = 200
 
 
+def state_matrix(M, K, D) -> np.ndarray:
+    """The first-order system matrix :math:`[0, I; -M^{-1}K, -M^{-1}D]` of :math:`M\\ddot q + D\\dot q + Kq`."""
+    N = M.shape[0]
+    Minv = np.linalg.inv(M)
+    return np.block([[np.zeros((N, N)), np.eye(N)], [-Minv @ K, -Minv @ D]])
+
+
 def shift_invert_roots(M, K, D, n: int, shift_hz: float, extra: int, name: str):
     """``(lam, Q)``: at most ``n`` underdamped roots (Im > 0) nearest ``shift_hz``, by frequency, and their
     displacement shapes (columns, not normalised).
@@ -40,8 +47,7 @@ def shift_invert_roots(M, K, D, n: int, shift_hz: float, extra: int, name: str):
     if 2 * N <= SMALL:
         # a small system: every root of M^-1 [K D] in first-order form by the balanced dense eigen-solve,
         # faster than Arnoldi there and never unconverged (as mutext.rotor.analysis does)
-        Minv = np.linalg.inv(M)
-        lam, X = np.linalg.eig(np.block([[np.zeros((N, N)), np.eye(N)], [-Minv @ K, -Minv @ D]]))
+        lam, X = np.linalg.eig(state_matrix(M, K, D))
         if np.any(np.abs(lam - sigma) <= 1e-9 * np.max(np.abs(lam), initial=1.0)):
             raise ModelError(f"{name}: A - sigma B is singular at shift_hz = {shift_hz:g}; a model with "
                              "rigid-body modes needs a nonzero shift_hz")

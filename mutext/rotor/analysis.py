@@ -80,7 +80,7 @@ import scipy.linalg as sla
 from ..errors import IllPosedError, ModelError, MutextError
 from ..lti import blas_single_thread, mck_to_ss
 from ..response import FRFMatrix
-from ._shift_invert import shift_invert_roots
+from ._shift_invert import shift_invert_roots, state_matrix
 
 __all__ = ["Modes", "Campbell", "modes", "natural_frequencies", "campbell", "frf",
            "state_space", "whirl_index", "blas_single_thread"]
@@ -318,7 +318,6 @@ def _modes(model, speed, values, n, rigid_tol, matrices, method="dense") -> Mode
                 raise
         else:
             return _as_modes(model, ev, shapes, speed)
-    ndof = M.shape[0]
     try:
         np.linalg.cholesky(M)
     except np.linalg.LinAlgError:
@@ -412,9 +411,7 @@ def _damped_modes(M, D, K, Ks, rigid_tol, model):
     scale = max(float(np.max(np.abs(lam_u))), 1e-300)          # omega_s^2
     n_rigid = int(np.sum(np.abs(lam_u) <= rigid_tol**2 * scale))
     cut = rigid_tol * math.sqrt(scale)                          # rigid_tol * omega_s [rad/s]
-    Minv = np.linalg.inv(M)
-    A = np.block([[np.zeros((ndof, ndof)), np.eye(ndof)], [-Minv @ K, -Minv @ D]])
-    lam, X = sla.eig(A)
+    lam, X = sla.eig(state_matrix(M, K, D))
     diverging = lam[(np.abs(lam.imag) <= cut) & (lam.real > cut)]
     if diverging.size:
         raise IllPosedError(_divergence(model, diverging.real))
