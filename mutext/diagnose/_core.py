@@ -763,12 +763,8 @@ def _after(verdict, text, path, rec, chans, all_fit, held):
             if rx.modal is not None:
                 fit_ch, _ = _resolve(ext, [c.frf for c in chans], "data")
                 held_ch, _ = _resolve(ext, [c.frf for c in held.chans], "validation")
-
-                def resp(c, f):
-                    pos = np.searchsorted(w_all, 2 * np.pi * np.asarray(f, float))
-                    return rx.modal.row(w_all[pos], c.out_dof) @ rx.input_vector(c.in_spec)
-                return ([resp(c, c.frf.freq_hz) for c in fit_ch],
-                        [resp(c, fs) for c, fs in zip(held_ch, held.freq_hz)])
+                return ([rx.channel(c, c.frf.freq_hz) for c in fit_ch],
+                        [rx.channel(c, fs) for c, fs in zip(held_ch, held.freq_hz)])
     return ([model_response(ext, c.frf) for c in chans],
             [model_response(ext, c.frf, freq_hz=fs) for c, fs in zip(held.chans, held.freq_hz)])
 

@@ -478,7 +478,6 @@ def _refit_on_modes(ext, name: str, lo: float, hi: float, x0: float, scale: floa
     speed = speeds.pop()
     w_all = np.unique(np.concatenate([2 * np.pi * np.asarray(fs, float) for fs in fit.freq_hz]))
     chans, _ = _resolve(ext, [c.frf for c in fit.chans], "data")
-    pos = [np.searchsorted(w_all, 2 * np.pi * np.asarray(fs, float)) for fs in fit.freq_hz]
     i = ext.parameter_names.index(name)
     base = ext.values()
 
@@ -488,8 +487,7 @@ def _refit_on_modes(ext, name: str, lo: float, hi: float, x0: float, scale: floa
         rec = _Receptance(ext, vals, speed, w_all)
         if rec.modal is None:
             raise _NotModal
-        r = np.concatenate([np.log((rec.modal.row(w_all[p], c.out_dof) @ rec.input_vector(c.in_spec)) / m)
-                            for c, p, m in zip(chans, pos, fit.meas)])
+        r = np.concatenate([np.log(rec.channel(c, fs) / m) for c, fs, m in zip(chans, fit.freq_hz, fit.meas)])
         return np.concatenate([r.real, r.imag])
 
     try:

@@ -204,6 +204,12 @@ class _Receptance:
         """Forget the modes of the damping-scaled models (formed again if asked for)."""
         self._modal_scaled = {}
 
+    def channel(self, chan, freq_hz) -> np.ndarray:
+        """Channel ``chan``'s response (output row times input vector) at ``freq_hz``, which must be among
+        this receptance's frequencies (the modal form only: formed at those frequencies alone)."""
+        w = self.omega[np.searchsorted(self.omega, 2 * np.pi * np.asarray(freq_hz, float))]
+        return self.modal.row(w, chan.out_dof) @ self.input_vector(chan.in_spec)
+
     def input_vector(self, spec) -> np.ndarray:
         kind, j = spec
         if kind == "port":
