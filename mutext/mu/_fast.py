@@ -66,6 +66,7 @@ class _DGParams:
             self.gcol = np.array([S.col_slices[k].start for k in self.real_idx], int)
             self.El = np.eye(self.m)[S.col_block]
             self.Er = np.eye(self.m)[S.row_block]
+            self.El2, self.Er2 = 2.0 * self.El, 2.0 * self.Er
 
     #: set by the caller: value_grad then also keeps what the first-order model of the top two
     #: eigenvalues (diagonal scalings only, :meth:`model`) is built from in ``cluster``
@@ -73,17 +74,19 @@ class _DGParams:
     cluster = None
 
     def model(self, gap: float):
-        """(lambda_2/lambda_1, C) at the point last evaluated, C (:meth:`_cluster`) only if the
-        relative gap of the two is below ``gap``; None without that evaluation."""
-        if self.cluster is None:
+        """(lambda_2/lambda_1, C) at the point last evaluated, C a function returning the
+        matrices of :meth:`_cluster` (built only when the descent steps on them) if the
+        relative gap of the two is below ``gap``, else None; None without that evaluation."""
+        cl = self.cluster
+        if cl is None:
             return None
-        A, w, V, beta0, gs, x = self.cluster
+        w = cl[1]
         if w.size < 2 or not w[-1] > 0:
             return None
         r = float(w[-2] / w[-1])
         if not 1.0 - r < gap:
             return r, None
-        return self._cluster(A, w, V, beta0, gs, x)
+        return r, lambda: self._cluster(*cl)[1]
 
     def _cluster(self, A, w, V, beta0, gs, x):
         r"""First-order model of the two largest eigenvalues of H, divided by the largest:
@@ -159,14 +162,14 @@ class _DGParams:
             # one scaling per block (coordinates 0..m-1), G-hat on 1 x 1 real blocks after them;
             # written with few numpy calls: this is the inner loop of the default bound
             m = self.m
-            e = np.exp(x[:m])
-            A = (e[S.col_block][:, None] * M) * (1.0 / e)[S.row_block]
+            # A_ij = e^(x_cb(i) - x_rb(j)) M_ij: the scalings of the blocks of row i and column j
+            A = M * np.exp(np.subtract.outer(x[S.col_block], x[S.row_block]))
             H = A.conj().T @ A
             if self.nreal:
                 gs = np.sinh(x[m:])
                 # j(GA - (GA)^H), G mapping column gcol of A (z of the real block) to row grow
                 # (its w): GA has the rows grow only
-                T = 1j * ((beta0 * gs)[:, None] * A[self.gcol])
+                T = ((1j * beta0) * gs)[:, None] * A[self.gcol]
                 H[self.grow] += T
                 H[:, self.grow] += T.conj().T
             w, V, info = _zheevd(H)
@@ -180,7 +183,7 @@ class _DGParams:
                 self.cluster = (A, w, V, beta0, gs if self.nreal else None, x)
             a = A @ v
             g = np.empty(self.size)
-            g[:m] = 2.0 * ((a.real ** 2 + a.imag ** 2) @ self.El - lam * ((v.real ** 2 + v.imag ** 2) @ self.Er))
+            g[:m] = (np.abs(a) ** 2) @ self.El2 - (np.abs(v) ** 2) @ (lam * self.Er2)
             if self.nreal:
                 im = (np.conj(v[self.grow]) * a[self.gcol]).imag
                 g[self.real_idx] -= 4.0 * beta0 * gs * im
@@ -287,7 +290,7 @@ _PRED_STOP = 1.0
 def _cluster_step(cl, B):
     r"""Step on the model of the two largest eigenvalues (Overton's idea, for a cluster of two).
 
-    ``cl = (r, C)``: :math:`\lambda_2/\lambda_1` and the ``2 x 2`` matrices
+    ``cl = (r, C)``: :math:`\lambda_2/\lambda_1` and a function returning the ``2 x 2`` matrices
     :math:`C_k = Q^H\partial_kHQ/\lambda_1`.  The model of :math:`\lambda_{\max}/\lambda_1`
     is :math:`c(d) + \|\rho(d)\|` (the largest eigenvalue of a ``2 x 2`` Hermitian
     matrix, affine in the step :math:`d`); the step minimises it plus
@@ -296,8 +299,10 @@ def _cluster_step(cl, B):
     :math:`d = -B(g_c + J^Tu)`.  Returns (d, predicted change of the model).
     """
     r, C = cl
-    gc = 0.5 * (C[:, 0, 0].real + C[:, 1, 1].real)
-    J = np.array([0.5 * (C[:, 0, 0].real - C[:, 1, 1].real), C[:, 0, 1].real, C[:, 0, 1].imag])
+    C = C()
+    c00, c11, c01 = C[:, 0, 0].real, C[:, 1, 1].real, C[:, 0, 1]
+    gc = 0.5 * (c00 + c11)
+    J = np.array([0.5 * (c00 - c11), c01.real, c01.imag])
     r0 = np.array([0.5 * (1.0 - r), 0.0, 0.0])
     BJ = B @ J.T
     Q3 = J @ BJ
@@ -312,18 +317,20 @@ def _cluster_step(cl, B):
     if not top > 1e-14 * nb:
         # the model's curvature vanishes (or is negligible): the linear part alone
         u = b / nb if nb > 0 else np.zeros(3)
-    elif q[0] > 1e-12 * top and float(np.sum((bb / q) ** 2)) <= 1.0:
-        u = V @ (bb / q)
+    elif q[0] > 1e-12 * top and float((bq := bb / q) @ bq) <= 1.0:
+        u = V @ bq
     else:
         # ||(Q3 + mu I)^-1 b|| = 1: Newton on 1 / ||u(mu)|| (More and Sorensen)
-        mu0 = max(0.0, -float(q[0]))
+        # (three terms: Python floats, faster than numpy calls on 3-vectors)
+        qs, bs = q.tolist(), bb.tolist()
+        mu0 = max(0.0, -qs[0])
         mu = mu0 + 1e-12 * top
         for _ in range(60):
-            z = bb / (q + mu)
-            nu = float(np.sqrt(z @ z))
+            zs = [bi / (qi + mu) for bi, qi in zip(bs, qs)]
+            nu = math.sqrt(sum(zi * zi for zi in zs))
             if not nu > 0:
                 break
-            dn = -float(z @ (z / (q + mu))) / nu
+            dn = -sum(zi * zi / (qi + mu) for zi, qi in zip(zs, qs)) / nu
             step = (1.0 / nu - 1.0) * nu * nu / dn
             mu_new = max(mu + step, mu0 + 0.5 * (mu - mu0))
             if abs(mu_new - mu) <= 1e-14 * max(mu, 1e-300):
@@ -335,7 +342,8 @@ def _cluster_step(cl, B):
         if nu > 1.0:
             u = u / nu
     d = -(B @ gc + BJ @ u)
-    pred = 0.5 * (r - 1.0) + float(gc @ d) + float(np.linalg.norm(r0 + J @ d))
+    rd = r0 + J @ d
+    pred = 0.5 * (r - 1.0) + float(gc @ d) + math.sqrt(float(rd @ rd))
     return d, pred
 
 
@@ -441,9 +449,8 @@ def _bfgs(fun, x0, B0=None, max_iter: int = 100, ftol: float = 1e-10, max_step: 
             kinked = True
         if not ok:
             if ft < f:          # a decrease without the curvature condition: keep it
-                x, f = xt, ft
-                g = fun(x)[1]
-                nev += 1
+                # (gt is the gradient there: xt was the last point evaluated)
+                x, f, g = xt, ft, gt
                 moved = True
                 cl = cluster() if cluster is not None else None
                 cl_fail = False
@@ -530,7 +537,7 @@ def _upper_fast(M, S: BlockStructure, params: _DGParams, x0=None, B0=None, ftol:
     if kinks and params.diag and S.nrows >= 2:
         def cluster():
             cl = params.model(_CLUSTER_GAP)
-            return cl if cl is None or cl[1] is None else (cl[0], cl[1][free])
+            return cl if cl is None or cl[1] is None else (cl[0], lambda: cl[1]()[free])
     params.want_cluster, params.cluster = cluster is not None, None
     try:
         with np.errstate(over="ignore", invalid="ignore"):
