@@ -125,7 +125,8 @@ def _resolve_channel(model, frf, k, inputs: _Inputs):
         in_name = model.inputs[cands[0]].name
     elif frf.input_quantity == "force":
         col = inputs.add(("dof", lay.dof(s_in, d_in)))
-        in_name = f"F{s_in}" + ("" if d_in in ("u", "x") else d_in)
+        # the force's direction named as the displacement's (x12, y12): F12 along x, F12y along y
+        in_name = f"F{s_in}" + ("" if d_in in ("u", "x") else "y" if d_in == "v" else d_in)
     else:  # pragma: no cover - FRF validates its quantity
         raise ModelError(f"FRF #{k}: unsupported input quantity {frf.input_quantity!r}")
     if frf.output_quantity != "displacement":  # pragma: no cover
