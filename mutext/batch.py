@@ -2,8 +2,9 @@ r"""Many diagnoses at once: a class's hidden-effect sets, a fleet of machines, a
 
 :func:`diagnose_batch` finds every data set under a directory -- a folder
 holding a model file ``model.toml`` and its measured FRFs in ``measured/``
-(CSV or UFF 58), optionally ``validate/`` and an ``answer_key.json``, as
-``mutext rig hide`` writes them -- runs :func:`mutext.diagnose.diagnose` on
+(CSV or UFF 58), optionally ``validate/`` (held-out FRFs), ``repeat/`` (the same
+sweeps at another excitation level, for the amplitude test) and an
+``answer_key.json``, as ``mutext rig hide`` writes them -- runs :func:`mutext.diagnose.diagnose` on
 each, writes each result beside its data (``<set>/diagnosis/``: report,
 figures, ``diagnosis.json``, extended model) and a summary
 (``summary.csv`` and ``index.html`` in the directory).  A data set that
@@ -80,7 +81,7 @@ def _one(folder: str, out_name: str, mbi: bool) -> dict:
     try:
         with threadpool_limits(1, "blas"):
             res = diagnose(str(d / "model.toml"), _files(d / "measured"), validate=_files(d / "validate") or None,
-                           mbi=mbi)
+                           repeat=_files(d / "repeat") or None, mbi=mbi)
             write_diagnosis(res, d / out_name)
         v = res.verdict
         # the description names the element ("spring k2 (m2-m3) changed", "grounded spring added at m2"):

@@ -191,3 +191,27 @@ def test_the_excitation_level_is_read_from_a_csv_header_or_a_universal_file_id_l
     assert level_of(replace(f, metadata={})) is None
     assert _lower("0.5 N", "2 N") == "measured" and _lower("2N", "0.5N") == "repeat"
     assert _lower("0.5 N", "0.1 A") is None and _lower(None, "1 N") is None and _lower("1 N", "1 N") is None
+
+
+def test_a_batch_data_set_with_a_repeat_folder_is_tested_for_amplitude_dependence(cubic, tmp_path):
+    """``repeat/`` beside ``measured/`` in a batch data set: the summary row carries the flag."""
+    import json
+    import shutil
+
+    from mutext.batch import diagnose_batch
+    from mutext.rig import write_frf
+    path, low, high, _, _ = cubic
+    rows = {}
+    d = tmp_path / "cubic"
+    for sub, sweeps in (("measured", low), ("repeat", high)):
+        (d / sub).mkdir(parents=True)
+        for k, f in enumerate(sweeps):
+            write_frf(d / sub / f"{sub[0]}{k}.csv", f)
+    shutil.copy(path, d / "model.toml")
+    for r in diagnose_batch(tmp_path):
+        rows[Path(r["data_set"]).name] = r
+    assert rows["cubic"]["status"] == "ok", rows["cubic"]
+    assert rows["cubic"]["diagnosis"] in ("partly explained", "not explained")
+    js = json.loads((tmp_path / "cubic" / "diagnosis" / "diagnosis.json").read_text(encoding="utf-8"))
+    assert js["amplitude_dependence"]["significant"], js["amplitude_dependence"]
+    assert js["amplitude_dependence"]["levels"] == {"measured": "0.2 N", "repeat": "1 N"}

@@ -36,7 +36,8 @@ def add_arguments(p):
                    help="also read the top finding by model-based identification (lumped chains; D-K iteration, "
                         "5-60 s more)")
     p.add_argument("--batch", metavar="DIR", help="diagnose every data set under DIR (a folder with model.toml and "
-                                                  "measured/, as 'mutext rig hide' writes); reports beside the data, "
+                                                  "measured/, optionally validate/ and repeat/, as 'mutext rig hide' "
+                                                  "writes); reports beside the data, "
                                                   "summary.csv and index.html in DIR")
     p.add_argument("--jobs", type=int, default=1, help="parallel workers for --batch (-1: all cores)")
     p.add_argument("--scheduler", metavar="ADDRESS", default=None,
