@@ -156,12 +156,15 @@ def fit_impedance(K, omega, weight=None, tol: float = 0.1) -> ImpedanceFit:
     res = float(np.linalg.norm(wn * (Kj - fit)) / max(np.linalg.norm(wn * Kj), 1e-300))
     # standard uncertainty: the weights are read as inverse standard deviations of K
     # (for the identification weights 1/|s|: the change of K that moves the
-    # normalised error by one); without weights, from the residual variance
-    cov = np.linalg.pinv(Aw.T @ Aw) / np.outer(col, col) / wscale ** 2
+    # normalised error by one); without weights, from the residual variance.  Only the diagonal
+    # is needed, and its square root is taken before the column and weight scales are undone:
+    # 1/wscale**2 overflows for weights beyond ~1e154 where 1/wscale does not
+    P = np.linalg.pinv(Aw.T @ Aw)
+    with np.errstate(over="ignore"):        # weights near 5e-324: an unbounded spread is inf
+        sigma = np.sqrt(np.maximum(np.diag(P), 0.0)) / col / wscale
     if weight is None:
         dof = max(2 * omega.size - 3, 1)
-        cov *= float(np.sum(np.abs(Kj - fit) ** 2)) / dof
-    sigma = np.sqrt(np.maximum(np.diag(cov), 0.0))
+        sigma = sigma * np.sqrt(float(np.sum(np.abs(Kj - fit) ** 2)) / dof)
     ok = res <= tol
     terms = []
     for val, sd, unit, what in zip((dm, dc, dk), sigma, ("kg", "N s/m", "N/m"), ("mass", "damper", "spring")):
