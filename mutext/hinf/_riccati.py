@@ -57,9 +57,18 @@ def _ric(H: np.ndarray):
     return _sym(X), ""
 
 
+_UNDECIDED = "undecided: "
+
+
+class _Undecided(Exception):
+    """The Riccati test cannot be evaluated at a level (see :data:`_UNDECIDED`)."""
+
+
 def _riccati_solutions(p: PlantParts, g: float):
     """``(X_inf, Y_inf, "")`` at level ``g`` if the four conditions of ZDG Theorem 17.1
-    hold, else ``(None, None, why)``; see :func:`riccati_feasible`."""
+    hold, else ``(None, None, why)``; see :func:`riccati_feasible`.  ``why`` starts with
+    :data:`_UNDECIDED` when the test could not be evaluated in double precision (``R`` or
+    ``R~`` singular to working precision: ``g**2`` lost against the gain of ``D11``)."""
     n, nw, nu, nz, ny = p.sizes
     A, B1, B2, C1, C2, D11, D12, D21 = p.A, p.B1, p.B2, p.C1, p.C2, p.D11, p.D12, p.D21
     P12 = D12 @ np.linalg.pinv(D12)
@@ -70,16 +79,26 @@ def _riccati_solutions(p: PlantParts, g: float):
     B = np.hstack([B1, B2])
     D1 = np.hstack([D11, D12])
     R = D1.T @ D1 - sla.block_diag(g * g * np.eye(nw), np.zeros((nu, nu)))
-    Hx = (np.block([[A, np.zeros((n, n))], [-C1.T @ C1, -A.T]])
-          - np.vstack([B, -C1.T @ D1]) @ np.linalg.solve(R, np.hstack([D1.T @ C1, B.T])))
+    try:
+        RiX = np.linalg.solve(R, np.hstack([D1.T @ C1, B.T]))
+    except np.linalg.LinAlgError:
+        # with D12 of full column rank and condition (i) met R is nonsingular; singular here means
+        # g**2 vanished against D11'D11 in rounding, so the conditions cannot be checked
+        return None, None, (f"{_UNDECIDED}R = D1'D1 - diag(g^2 I, 0) is singular to working precision at "
+                            f"g = {g:.6g} (gain of [D11 D12] {np.linalg.norm(D1, 2):.3g})")
+    Hx = np.block([[A, np.zeros((n, n))], [-C1.T @ C1, -A.T]]) - np.vstack([B, -C1.T @ D1]) @ RiX
     X, why = _ric(Hx)
     if X is None:
         return None, None, "X_inf: " + why
     C = np.vstack([C1, C2])
     Dc = np.vstack([D11, D21])
     Rt = Dc @ Dc.T - sla.block_diag(g * g * np.eye(nz), np.zeros((ny, ny)))
-    Jy = (np.block([[A.T, np.zeros((n, n))], [-B1 @ B1.T, -A]])
-          - np.vstack([C.T, -B1 @ Dc.T]) @ np.linalg.solve(Rt, np.hstack([Dc @ B1.T, C])))
+    try:
+        RiY = np.linalg.solve(Rt, np.hstack([Dc @ B1.T, C]))
+    except np.linalg.LinAlgError:
+        return None, None, (f"{_UNDECIDED}R~ = D.1 D.1' - diag(g^2 I, 0) is singular to working precision at "
+                            f"g = {g:.6g} (gain of [D11; D21] {np.linalg.norm(Dc, 2):.3g})")
+    Jy = np.block([[A.T, np.zeros((n, n))], [-B1 @ B1.T, -A]]) - np.vstack([C.T, -B1 @ Dc.T]) @ RiY
     Y, why = _ric(Jy)
     if Y is None:
         return None, None, "Y_inf: " + why
@@ -118,9 +137,21 @@ def riccati_feasible(p: PlantParts, g: float) -> bool:
     Returns
     -------
     bool
-        True when the four conditions hold at ``g``.
+        True when the four conditions hold at ``g``; False when one fails, or when they
+        cannot be evaluated in double precision (``R`` or :math:`\tilde R` singular to
+        working precision, ``g**2`` lost against the gain of ``D11``).
     """
     return _riccati_solutions(p, g)[2] == ""
+
+
+def _decided(p: PlantParts, g: float) -> bool:
+    """:func:`riccati_feasible` for the bisections: raises :class:`_Undecided` where the test
+    cannot be evaluated, instead of counting the level as infeasible (which would move the
+    bracket to where double precision gives out, not to the optimum)."""
+    why = _riccati_solutions(p, g)[2]
+    if why.startswith(_UNDECIDED):
+        raise _Undecided(why)
+    return why == ""
 
 
 def _normalise_d12_d21(p: PlantParts):
@@ -155,22 +186,31 @@ def _riccati_level(p: PlantParts, rtol: float = 1e-10, max_steps: int = 200):
 
     Returns ``(gamma, steps)``: ``gamma`` is a level where the Riccati
     conditions hold and ``gamma (1 - rtol)`` one where they fail; or ``None``
-    if no feasible level is found (numerical trouble: the LMIs take over)."""
+    if no feasible level is found or the test cannot be evaluated at a level the
+    bisection needs (numerical trouble: the LMIs take over)."""
     q, _, _ = _normalise_d12_d21(p)
+    try:
+        return _bisect_level(q, rtol, max_steps)
+    except _Undecided:
+        return None
+
+
+def _bisect_level(q: PlantParts, rtol: float, max_steps: int):
+    """The bisection of :func:`_riccati_level` on the normalised plant ``q``."""
     _, nw, nu, nz, ny = q.sizes
     m1, p1 = nw - ny, nz - nu
     # condition (i): below the gain of [D1111 D1112] and [D1111; D1121] nothing is feasible
     lo = max(np.linalg.norm(q.D11[:p1], 2) if p1 else 0.0, np.linalg.norm(q.D11[:, :m1], 2) if m1 else 0.0)
     steps = 0
     hi = max(2.0 * lo, 1.0)
-    while not riccati_feasible(q, hi):
+    while not _decided(q, hi):
         steps += 1
         lo, hi = hi, 4.0 * hi
         if steps > 40 or not np.isfinite(hi):
             return None
     if lo == 0.0:
         lo = hi
-        while riccati_feasible(q, lo):
+        while _decided(q, lo):
             steps += 1
             hi, lo = lo, 0.25 * lo
             if steps > 80:
@@ -178,7 +218,7 @@ def _riccati_level(p: PlantParts, rtol: float = 1e-10, max_steps: int = 200):
     while hi > lo * (1.0 + rtol) and steps < max_steps:
         steps += 1
         mid = np.sqrt(lo * hi)
-        if riccati_feasible(q, mid):
+        if _decided(q, mid):
             hi = mid
         else:
             lo = mid
@@ -218,24 +258,33 @@ def _near_axis_hint(P, ratio: float = 1e-6) -> str:
 
 def _refine_level(p: PlantParts, g_lmi: float, rtol: float = 1e-10):
     """Bisection on :func:`riccati_feasible` around the LMI level.  Returns the
-    refined level, or None if the test does not bracket the LMI level."""
+    refined level, or None if the test does not bracket the LMI level or cannot be
+    evaluated at a level the bisection needs (the LMI level then stands)."""
+    try:
+        return _bisect_refine(p, g_lmi, rtol)
+    except _Undecided:
+        return None
+
+
+def _bisect_refine(p: PlantParts, g_lmi: float, rtol: float):
+    """The bisection of :func:`_refine_level`."""
     hi = g_lmi * (1 + 1e-3)
     for _ in range(8):
-        if riccati_feasible(p, hi):
+        if _decided(p, hi):
             break
         hi *= 1.5
     else:
         return None
     lo = g_lmi * (1 - 1e-2)
     for _ in range(8):
-        if not riccati_feasible(p, lo):
+        if not _decided(p, lo):
             break
         lo *= 0.5
     else:
         return None
     while hi - lo > rtol * hi:
         mid = 0.5 * (lo + hi)
-        if riccati_feasible(p, mid):
+        if _decided(p, mid):
             hi = mid
         else:
             lo = mid
