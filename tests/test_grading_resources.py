@@ -5,7 +5,8 @@ child's address-space limit does not count (memfds, System V shared memory and m
 socket pairs), to fill the disk (a deep tree of unreadable directories, 1 GiB of files, half of them
 deleted but held open, 30,000 empty files) and to forge a result far larger than any honest one.  As
 root the child's scratch directory is a tmpfs of 256 MiB and 10,000 files in its own mount namespace;
-as a plain user the parent measures the directory every second and stops the child beyond that.
+as a plain user the parent measures the directory every second and at the end of each question, and
+stops the child beyond that (naming the question that left the files).
 Either way every question scores 0, the grader's memory and time stay bounded and nothing is left in
 /tmp, /var/tmp or /dev/shm afterwards.  The rest checks the parts one by one: the size caps on the
 values the child returns, over-long lines on its channel, one wall-clock budget per submission,
@@ -147,6 +148,39 @@ def test_returned_values_are_capped_in_size():
     t0 = time.process_time()            # CPU time: the same on a busy machine
     assert sandbox._clean_calls("ss", [{"ok": True, "value": huge}], 1)[0]["ok"] is False
     assert time.process_time() - t0 < 0.5
+
+
+FLOOD = """\
+import os
+
+
+def flood():
+    os.makedirs("many", exist_ok=True)
+    for n in range(10_050):
+        os.close(os.open(f"many/f{n}", os.O_WRONLY | os.O_CREAT, 0o600))
+    return 1.0
+
+
+def quiet():
+    return 2.0
+"""
+
+
+def test_files_left_by_a_question_are_its_own(tmp_path, monkeypatch, machine_left_as_it_was):
+    """A question that floods the scratch directory between two measurements and returns is stopped at its
+    end, not the question that runs after it in the same child (which runs again in a clean child)."""
+    from mutext.grading import _child
+    monkeypatch.setattr(sandbox, "FORCE_MODE", "user")          # no tmpfs: the parent measures
+    monkeypatch.setattr(_child, "SCRATCH_CHECK_INTERVAL", 1e6)  # no periodic measurement in between
+    sub = tmp_path / "flood.py"
+    sub.write_text(FLOOD)
+    jobs = [Job("c", "flood", "float", [{"args": []}]), Job("d", "quiet", "float", [{"args": []}])]
+    res = run_submission(sub, jobs, time_limit=60)
+    c, d = res.questions["c"], res.questions["d"]
+    assert c.status == "crashed" and "it created more than 10000 files" in c.error, c
+    assert c.last_call is None
+    assert d.status == "ok" and d.calls == [{"ok": True, "value": 2.0}], d
+    assert res.children == 2
 
 
 def test_overlong_lines_on_the_channel_are_skipped_unread(tmp_path):

@@ -41,14 +41,30 @@ def _kill(proc):
         pass
 
 
+def _measure_at_end(scratch, proc, phase, outcome):
+    """At the end of ``phase`` (its result just read): ``(phase, "disk", why)`` if the child's files are
+    over the disk budget now, else None.  The files are that phase's (the next one has at most just
+    begun), so it, not the next, is stopped; which of its calls made them is not known (``last_call``
+    cleared)."""
+    if scratch is None:
+        return None
+    why = scratch.over(proc.pid)
+    if not why:
+        return None
+    outcome.last_call = None
+    return (phase, "disk", why)
+
+
 def _run_once(workdir, plan, jobs, time_limit, outcomes, imp, log, state, scratch=None, total_limit=None):
     """Start one child for ``jobs``; fill ``outcomes``/``imp``; return the phase that was cut short as
     ``(phase, status, exit code or reason)``.
 
     ``total_limit``: seconds for the whole submission, counted from the first child's boot (``state``
     keeps that time across children); beyond it the child is stopped with status ``"budget"``.
-    ``scratch`` (a :class:`_Scratch`) is measured every :data:`SCRATCH_CHECK_INTERVAL` seconds; a child
-    over the disk budget is stopped with status ``"disk"``."""
+    ``scratch`` (a :class:`_Scratch`) is measured every :data:`SCRATCH_CHECK_INTERVAL` seconds and at the
+    end of each phase; a child over the disk budget is stopped with status ``"disk"``, the phase it is in
+    named, or the phase that has just ended when that one left the files behind (a question that floods the
+    directory between two periodic measurements, then returns, is named, not the question after it)."""
     nonce = secrets.token_hex(16)
     results = workdir / f"results-{nonce}.jsonl"
     request = workdir / f"request-{nonce}.json"
@@ -96,7 +112,7 @@ def _run_once(workdir, plan, jobs, time_limit, outcomes, imp, log, state, scratc
                     state["details"].append(
                         f"scratch directory: no tmpfs of its own; {FILE_SIZE_LIMIT // 2 ** 20} MiB per file, "
                         f"the grader stops the child beyond {SCRATCH_BYTES // 2 ** 20} MiB or {SCRATCH_FILES} "
-                        f"files (measured every {SCRATCH_CHECK_INTERVAL:g} s)")
+                        f"files (measured every {SCRATCH_CHECK_INTERVAL:g} s and at the end of each phase)")
                 if ev.get("fatal"):
                     state["fatal"] = str(ev["fatal"])[:500]
             elif kind == "boot" and stage == "confined":
@@ -118,11 +134,18 @@ def _run_once(workdir, plan, jobs, time_limit, outcomes, imp, log, state, scratc
                 imp.error = str(ev.get("error", ""))[:2000]
                 imp.seconds = now - t0
                 phase, t0 = None, now
+                cut = _measure_at_end(scratch, proc, p, imp)
             elif kind == "result" and p == phase and p in outcomes:
                 o = outcomes[p]
                 kind_, n = kinds[p]
                 o.status, o.calls, o.seconds = "ok", _clean_calls(kind_, ev.get("calls"), n), now - t0
                 phase, t0 = None, now
+                cut = _measure_at_end(scratch, proc, p, o)
+            if cut is not None:
+                break
+        if cut is not None:          # a phase that has ended left too much on disk
+            _kill(proc)
+            break
         if rc is not None:
             if phase is not None:
                 cut = (phase, "crashed", rc)
