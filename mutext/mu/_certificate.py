@@ -59,6 +59,16 @@ def _block_power(D, slices, p: float):
     return out
 
 
+def _pow2_scale(A) -> float:
+    """A power of two ``c`` with ``c * max|A|`` near 1 when ``max|A|`` is outside 1e-100..1e100,
+    else 1: the D-G forms are quadratic in ``A``, so entries near 1e-162 square to 0 (and near
+    1e+155 to inf); scaling by a power of two before squaring and back after is exact."""
+    a = float(np.abs(A).max()) if A.size else 0.0
+    if a == 0.0 or not np.isfinite(a) or 1e-100 <= a <= 1e100:
+        return 1.0
+    return float(np.ldexp(1.0, min(max(-int(np.frexp(a)[1]), -1000), 1000)))   # 2**1073 would overflow
+
+
 def _gevp(M, Dl, Dr, G, S: BlockStructure) -> float:
     r"""Smallest :math:`\beta\ge 0` with :math:`M^HD_\ell M + j(GM - M^HG^H) \preceq \beta^2 D_r`.
 
@@ -73,14 +83,17 @@ def _gevp(M, Dl, Dr, G, S: BlockStructure) -> float:
     if Lh is None or Ri is None:
         return np.inf
     A = Lh @ M @ Ri
+    c = _pow2_scale(A)           # the value is homogeneous in (M, G): computed for (c M, c G)
+    if c != 1.0:
+        A = c * A
     H = A.conj().T @ A
     if G is not None:
         Lhi = _block_power(Dl, S.col_slices, -0.5)
-        GA = (Ri @ G @ Lhi) @ A
+        GA = (c * (Ri @ G @ Lhi)) @ A
         H = H + 1j * (GA - GA.conj().T)
     H = 0.5 * (H + H.conj().T)
     lam = np.linalg.eigvalsh(H).max()
-    return float(np.sqrt(max(lam, 0.0)))
+    return float(np.sqrt(max(lam, 0.0))) / c
 
 
 def dg_bound(M, structure: BlockStructure, Dl, Dr, G=None, *, tol: float = 1e-9) -> float:

@@ -6,7 +6,7 @@ from scipy.linalg.lapack import zheevd as _zheevd
 
 from .._validation import NoneOr, Options, Real, validate_params
 from ..errors import ModelError, SolverError
-from ._certificate import MuUpper, _diag_result, _gevp
+from ._certificate import MuUpper, _diag_result, _gevp, _pow2_scale
 from ._fast import _DGParams, _fast_default, _fast_polish
 from ._lmi import _lmi_bisect
 from ._osborne import _upper_osborne
@@ -48,13 +48,16 @@ def _gevp_diagonal(M, Dl, Dr, G):
         return np.inf
     lh, ri = np.sqrt(dl), 1.0 / np.sqrt(dr)
     A = (lh[:, None] * M) * ri
+    c = _pow2_scale(A)           # as in _gevp: exact rescaling of entries that would underflow when squared
+    if c != 1.0:
+        A = c * A
     H = A.conj().T @ A
     if G is not None:
-        GA = ((ri[:, None] * G) / lh) @ A
+        GA = ((ri[:, None] * (c * G)) / lh) @ A
         H = H + 1j * (GA - GA.conj().T)
     w, _, info = _zheevd(H, compute_v=0)       # one triangle: H is Hermitian up to rounding
     lam = w[-1] if info == 0 else np.linalg.eigvalsh(0.5 * (H + H.conj().T))[-1]
-    return float(np.sqrt(max(lam, 0.0)))
+    return float(np.sqrt(max(lam, 0.0))) / c
 
 
 def _certify(M, S: BlockStructure, up: MuUpper) -> MuUpper | None:
