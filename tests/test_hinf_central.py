@@ -257,17 +257,29 @@ def test_closed_loop_stability_verdict_names_the_deciding_pole():
 def mbi_plants():
     """The plants of the K steps of the cracked-rotor identification (``mutext demo crack``,
     thesis data path): D21 ~ 1e-10 (measurement noise regularisation), lightly damped rotor
-    modes.  The LMI controller failed at every back-off on one of them, slycot times out."""
+    modes.  The LMI controller failed at every back-off on one of them, slycot times out.
+
+    The demo identifies by the convex route (``identify(method="auto")``), which synthesizes no
+    H-infinity controller; the K steps are those of the thesis's W_z search by D-K iteration,
+    ``identify(method="dk")``, which the demo is made to run here.  Each W_z try hands its plant
+    to :func:`mutext.dk.dk_iteration` (looked up in :mod:`mutext.dk` at every search), whose
+    first K step synthesizes on it as given."""
     import mutext.dk as dkm
+    import mutext.mbi as mbi
     from mutext.demos import crack
     cap = []
-    orig = dkm.dk_iteration
+    orig, identify = dkm.dk_iteration, mbi.identify
 
     def record(P, structure, nmeas, ncon, **kw):
         cap.append((P, nmeas, ncon))
         return orig(P, structure, nmeas, ncon, **kw)
+
+    def by_dk(*args, **kw):
+        assert kw.get("method", "auto") == "auto", kw["method"]
+        return identify(*args, **{**kw, "method": "dk"})
     mp = pytest.MonkeyPatch()
     mp.setattr(dkm, "dk_iteration", record)
+    mp.setattr(mbi, "identify", by_dk)          # the demo imports it from mutext.mbi when it runs
     try:
         with warnings.catch_warnings():
             warnings.simplefilter("ignore")
