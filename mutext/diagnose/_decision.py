@@ -9,7 +9,7 @@ import numpy as np
 import scipy.stats as sst
 
 from ._fit_quality import fit_quality
-from ._result import Finding
+from ._result import PARTLY_GAIN, Finding
 from ._screen import _separating_station
 from ._select import MAX_EFFECTS, Compound, _rss_of, at_bound, fit_one_given, joint_fit
 
@@ -76,13 +76,13 @@ def _decide(findings, none, threshold, N, rec, fit, eng, notes, held, s2):
 
 def _status(effects, quality, gain, held_quality) -> str:
     """Explained: the fitted and the held-out data at the noise (and, with effects, the held-out data better
-    than before); partly: effects that help on held-out data, a residual above the noise; otherwise not
-    explained."""
+    than before); partly: effects that remove at least half of the held-out misfit (:data:`PARTLY_GAIN`),
+    a residual above the noise; otherwise not explained."""
     # a channel's scale acts on its own file only: other files cannot confirm it, only not contradict it
     better = gain > 1 or (bool(effects) and all(e.kind == "channel_scale" for e in effects) and gain >= 1 - 1e-9)
     if quality.at_noise and held_quality.at_noise:
         return "explained" if (not effects or better) else "not explained"
-    return "partly explained" if (effects and better) else "not explained"
+    return "partly explained" if (effects and gain >= PARTLY_GAIN) else "not explained"
 
 
 def _in_model_file(f) -> bool:
