@@ -19,13 +19,13 @@ import numpy as np
 
 from ..errors import ModelError
 from ..lti import as_ss, blas_single_thread, freqresp, lft_lower
-from ..mu import BlockStructure, default_grid
+from ..mu import BlockStructure
 from ._dgstep import _dg_points, _refine_step
 from ._dscale import _check_sizes
 from ._loop import DKResult
 from ._modal import _augmented_loop, _Modal
 from ._report import _print
-from ._sweep import _around_peaks, _default_dk_grid, _final_analysis, _local_maxima, near_axis_poles
+from ._sweep import _around_peaks, _default_dk_grid, _final_analysis, _local_maxima, _loop_grid, near_axis_poles
 
 
 def refine_controller(P, structure: BlockStructure, K, nmeas: int, ncon: int, *, omega=None,
@@ -203,7 +203,7 @@ class _Problem:
         poles of ``P`` whose frequencies every grid leaves out."""
         P = self.P
         if omega is None:
-            w = np.unique(np.concatenate([default_grid(CL0, n=200, decades=1.5), _default_dk_grid(P, 80)]))
+            w = np.unique(np.concatenate([_loop_grid(CL0, 200), _default_dk_grid(P, 80)]))
         else:
             w = np.unique(np.asarray(omega, float).ravel())
             if w.size == 0 or not (np.all(np.isfinite(w)) and np.all(w > 0)):
@@ -382,8 +382,10 @@ class _Descent:
 def _descend(d: _Descent, max_steps, time_limit, regrid_every, out, t0):
     """Rounds of model steps, each ended by the fine grid of the final analysis; while that
     finds a peak the refinement grid missed (at most three times), its frequencies join the
-    grid and ``regrid_every`` more steps follow.  Returns the last loop and its analysis."""
-    prob, limit = d.prob, max_steps
+    grid and ``regrid_every`` more steps follow.  Returns the loop with the lowest bound on its
+    fine grid among the checks (a later round, on a grid with the peak it missed, can end higher
+    than an earlier one), its analysis and its round."""
+    prob, limit, best = d.prob, max_steps, None
     for check in range(4):
         d.round = check
         with blas_single_thread():
@@ -391,6 +393,8 @@ def _descend(d: _Descent, max_steps, time_limit, regrid_every, out, t0):
         Kr = prob.modal.ss(d.theta)
         f = 0.05 + 0.88 * min(d.step, max_steps) / max_steps     # the bar holds while the fine grid is checked
         CL, (final, low, low_c, mu_dg, extra) = prob.analysed(Kr, (f, f))
+        if best is None or mu_dg < best[2][3]:
+            best = (Kr, CL, (final, low, low_c, mu_dg, extra), check)
         on_grid = d.peak()
         if d.timed_out or check == 3 or mu_dg <= on_grid * (1.0 + 1e-4):
             break
@@ -403,14 +407,17 @@ def _descend(d: _Descent, max_steps, time_limit, regrid_every, out, t0):
                        f"{regrid_every} more steps follow")
         d.set_grid(prob.usable(np.unique(np.concatenate([d.w, final.omega, extra]))))
         d.rho, limit = max(d.rho, 1e-4), d.step + regrid_every
-    return Kr, CL, (final, low, low_c, mu_dg, extra)
+    return best
 
 
 def _refined_result(d: _Descent, K, given, checked, start, out, t0) -> DKResult:
     """The refined controller, or the one given if the final grid does not find it lower."""
     notes, P = d.notes, d.prob.P
-    Kr, CL, (final, low, low_c, mu_dg, _) = checked
+    Kr, CL, (final, low, low_c, mu_dg, _), kept = checked
     CLg, fin_g = given
+    if kept < d.round:
+        notes.append(f"refine: the loop at the end of round {kept} is returned: on its fine grid it is lower "
+                     f"({mu_dg:.5f}) than the later rounds' loops")
     if d.accepted and fin_g[3] < mu_dg:
         notes.append(f"refine: on the final grid the refined loop ({mu_dg:.5f}) is not below the loop "
                      f"given ({fin_g[3]:.5f}): the controller given is returned")
