@@ -66,7 +66,6 @@ class _DGParams:
             self.gcol = np.array([S.col_slices[k].start for k in self.real_idx], int)
             self.El = np.eye(self.m)[S.col_block]
             self.Er = np.eye(self.m)[S.row_block]
-            self.El2, self.Er2 = 2.0 * self.El, 2.0 * self.Er
 
     #: set by the caller: value_grad then also keeps what the first-order model of the top two
     #: eigenvalues (diagonal scalings only, :meth:`model`) is built from in ``cluster``
@@ -162,8 +161,8 @@ class _DGParams:
             # one scaling per block (coordinates 0..m-1), G-hat on 1 x 1 real blocks after them;
             # written with few numpy calls: this is the inner loop of the default bound
             m = self.m
-            # A_ij = e^(x_cb(i) - x_rb(j)) M_ij: the scalings of the blocks of row i and column j
-            A = M * np.exp(np.subtract.outer(x[S.col_block], x[S.row_block]))
+            e = np.exp(x[:m])
+            A = (e[S.col_block][:, None] * M) * (1.0 / e)[S.row_block]
             H = A.conj().T @ A
             if self.nreal:
                 gs = np.sinh(x[m:])
@@ -183,7 +182,7 @@ class _DGParams:
                 self.cluster = (A, w, V, beta0, gs if self.nreal else None, x)
             a = A @ v
             g = np.empty(self.size)
-            g[:m] = (np.abs(a) ** 2) @ self.El2 - (np.abs(v) ** 2) @ (lam * self.Er2)
+            g[:m] = 2.0 * ((a.real ** 2 + a.imag ** 2) @ self.El - lam * ((v.real ** 2 + v.imag ** 2) @ self.Er))
             if self.nreal:
                 im = (np.conj(v[self.grow]) * a[self.gcol]).imag
                 g[self.real_idx] -= 4.0 * beta0 * gs * im
