@@ -427,7 +427,10 @@ def frequency_grid(band=None, n: int = 400, *, poles=(), margin=(10.0, 10.0), sp
     poles = np.atleast_1d(np.asarray(poles, complex))
     lo, hi = _grid_band(band, poles, margin)
     if spacing == "log":
-        w = np.logspace(np.log10(max(lo, 1e-6 * hi)), np.log10(hi), n)
+        # only a band that starts at 0 is cut (six decades below its top): a positive lower end is
+        # kept however far down it lies (a weight's poles at 1e-6 rad/s; a grid cut at 1e-2 missed
+        # what a controller does below them)
+        w = np.logspace(np.log10(lo if lo > 0 else 1e-6 * hi), np.log10(hi), n)
         if lo == 0.0:
             w = np.concatenate([[0.0], w])
     elif spacing == "linear":

@@ -19,13 +19,13 @@ import numpy as np
 
 from ..errors import ModelError
 from ..lti import as_ss, blas_single_thread, freqresp, lft_lower
-from ..mu import BlockStructure
+from ..mu import BlockStructure, default_grid
 from ._dgstep import _dg_points, _refine_step
 from ._dscale import _check_sizes
 from ._loop import DKResult
 from ._modal import _augmented_loop, _Modal
 from ._report import _print
-from ._sweep import _around_peaks, _default_dk_grid, _final_analysis, _local_maxima, _loop_grid, near_axis_poles
+from ._sweep import _around_peaks, _default_dk_grid, _final_analysis, _local_maxima, near_axis_poles
 
 
 def refine_controller(P, structure: BlockStructure, K, nmeas: int, ncon: int, *, omega=None,
@@ -203,7 +203,7 @@ class _Problem:
         poles of ``P`` whose frequencies every grid leaves out."""
         P = self.P
         if omega is None:
-            w = np.unique(np.concatenate([_loop_grid(CL0, 200), _default_dk_grid(P, 80)]))
+            w = np.unique(np.concatenate([default_grid(CL0, n=200, decades=1.5), _default_dk_grid(P, 80)]))
         else:
             w = np.unique(np.asarray(omega, float).ravel())
             if w.size == 0 or not (np.all(np.isfinite(w)) and np.all(w > 0)):

@@ -66,29 +66,6 @@ def _default_dk_grid(P, n: int) -> np.ndarray:
     return default_grid(P, n=n, decades=1.5)
 
 
-def _loop_grid(sys, n: int) -> np.ndarray:
-    """The final analysis's grid of a loop: ``n`` log-spaced points from 1.5 decades below its
-    slowest pole to 1.5 decades above its fastest, plus the resonance points of
-    :func:`default_grid`.  That is ``default_grid(sys, n)`` where the band is at most six decades
-    wide; ``default_grid`` (``response.frequency_grid``) samples a wider band from six decades
-    below its top only, so on the distillation column, whose weight's poles at -1e-6 rad/s stay
-    poles of every loop, its grid started at 0.01 rad/s: mu below the weight's poles, set by the
-    controller's gain there, went unseen, and :func:`refine_controller` moved the controller's
-    slow poles from -1e-6 to -4e-6 and -6e-6 unchecked (AB13MD 5.10 at 1e-8 rad/s where the grid
-    read 1.026)."""
-    w = default_grid(sys, n=n, decades=1.5)
-    sys = as_ss(sys)
-    p = np.linalg.eigvals(np.asarray(sys.A, float)) if sys.nstates else np.zeros(0)
-    mags = np.abs(p[p != 0])
-    if not mags.size or w.size == 0:
-        return w
-    lo, hi = mags.min() / 10 ** 1.5, max(mags.max() * 10 ** 1.5, w[-1])
-    if lo >= w[0] * (1 - 1e-12):
-        return w
-    # default_grid of two points: the ends of its (clipped) band and the resonance points
-    return np.unique(np.concatenate([np.logspace(np.log10(lo), np.log10(hi), n), default_grid(sys, n=2, decades=1.5)]))
-
-
 def _clip_grid(w, lo, hi, n):
     """``n`` log-spaced points on [lo, hi] plus the points of ``w`` inside it (resonances)."""
     inside = w[(w >= lo) & (w <= hi)]
@@ -210,7 +187,7 @@ def _final_analysis(CL, S: BlockStructure, grid, final_points: int, dg: bool, np
     beat = report                   # no heartbeat thread when nobody listens
     report = report or (lambda stage, fraction: None)
     Sc = S.complexified()
-    fine = np.unique(np.concatenate([_loop_grid(CL, final_points), grid]))
+    fine = np.unique(np.concatenate([default_grid(CL, n=final_points, decades=1.5), grid]))
     final, H = _fine_sweep(CL, Sc, fine, npeaks=npeaks,
                         progress=lambda f: report(f"final-analysis: mu sweep, {fine.size} frequencies", 0.4 * f))
     ups = final.upper
