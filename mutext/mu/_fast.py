@@ -168,7 +168,7 @@ class _DGParams:
                 gs = np.sinh(x[m:])
                 # j(GA - (GA)^H), G mapping column gcol of A (z of the real block) to row grow
                 # (its w): GA has the rows grow only
-                T = ((1j * beta0) * gs)[:, None] * A[self.gcol]
+                T = 1j * ((beta0 * gs)[:, None] * A[self.gcol])
                 H[self.grow] += T
                 H[:, self.grow] += T.conj().T
             w, V, info = _zheevd(H)
