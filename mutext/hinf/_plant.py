@@ -113,7 +113,12 @@ def _axis_rank_losses(parts: PlantParts, tol: float = 1e-9) -> list[tuple[str, s
                                ("[A - jwI, B1; C2, D21]", parts.B1, parts.C2, parts.D21, False)):
         cands = axis(A)
         if D.shape[0] == D.shape[1] and D.size and np.linalg.cond(D) < 1e12:
-            cands += axis(A - B @ np.linalg.solve(D, C))
+            with np.errstate(all="ignore"):
+                Az = A - B @ np.linalg.solve(D, C)
+            # a D of subnormal entries is well conditioned yet its inverse overflows: the
+            # invariant zeros are then beyond any frequency, none of them on the axis
+            if np.all(np.isfinite(Az)):
+                cands += axis(Az)
         bad = []
         for lam in sorted({complex(round(c.real, 12), round(c.imag, 9)) for c in cands}, key=lambda c: c.imag):
             M = np.block([[(A - lam * np.eye(n)) / sa, B], [C, D]])

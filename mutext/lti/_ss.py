@@ -124,7 +124,12 @@ def ss(A, B, C, D, *, inputs=None, outputs=None, states=None, name=None) -> ct.S
         kw["states"] = list(states)
     if name is not None:
         kw["name"] = name
-    return ct.ss(A, B, C, D, **kw)
+    try:
+        return ct.ss(A, B, C, D, **kw)
+    except ct.ControlDimension as exc:
+        # python-control reads an n x 0 input matrix as 0 x 0 (a system with states but no input)
+        raise ModelError(f"{what}: python-control cannot hold A {A.shape}, B {B.shape}, C {C.shape}, "
+                         f"D {D.shape} ({exc}); a system with states needs at least one input") from None
 
 
 def as_ss(sys, what: str = "system") -> ct.StateSpace:

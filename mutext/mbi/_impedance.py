@@ -132,9 +132,14 @@ def fit_impedance(K, omega, weight=None, tol: float = 0.1) -> ImpedanceFit:
         if np.any(wgt < 0):
             i = int(np.flatnonzero(wgt < 0)[0])
             raise ModelError(f"fit_impedance: weight[{i}] = {wgt[i]:g} is negative (weights must be >= 0)")
-        if np.count_nonzero(wgt) < 2:
-            raise ModelError(f"fit_impedance: only {np.count_nonzero(wgt)} of the {wgt.size} weights are "
-                             "positive; at least 2 frequencies must count to determine mass, damper and spring")
+        # a weight below 1e-8 of the largest counts as zero: two frequencies whose weights differ by
+        # 1e13 determine the three values no better than one frequency does (the lesser one's
+        # equations are lost in the rounding of the greater's)
+        counted = int(np.count_nonzero(wgt > 1e-8 * wgt.max())) if wgt.max() > 0 else 0
+        if counted < 2:
+            raise ModelError(f"fit_impedance: only {counted} of the {wgt.size} weights are positive and "
+                             "within 1e-8 of the largest; at least 2 frequencies must count to determine "
+                             "mass, damper and spring")
     if not (isinstance(tol, (int, float, np.integer, np.floating)) and np.isfinite(tol) and tol >= 0):
         raise ModelError(f"fit_impedance: tol must be a non-negative finite number, got {tol!r}")
     # real part: dk - w^2 dm; imaginary part: w dc; scale the columns for conditioning
