@@ -17,6 +17,13 @@ def test_demo_rotor_campbell_and_orbit(capsys):
     assert len(crit) == 1
     assert crit[0]["speed_rpm"] == pytest.approx(60.0 * crit[0]["frequency_hz"], rel=1e-3)
     assert crit[0]["frequency_hz"] == pytest.approx(out["natural_frequencies_hz"]["healthy"][1], rel=0.01)
+    # the 2x line meets the first forward mode at half that speed (rpm = 30 f: near 1020 rpm), where a
+    # breathing crack's 2x response resonates; the 3x line at a third (rpm = 20 f)
+    for k in (2, 3):
+        first = cb[f"critical_speeds_{k}x_forward"][0]
+        assert first["speed_rpm"] == pytest.approx(60.0 / k * first["frequency_hz"], rel=1e-3)
+        assert first["frequency_hz"] == pytest.approx(out["natural_frequencies_hz"]["healthy"][1], rel=0.01)
+        assert first["speed_rpm"] == pytest.approx(crit[0]["speed_rpm"] / k, rel=0.01)
     # orbit: isotropic bearings give a forward circle of radius |H(F15 -> x13)| U Omega^2
     from mutext.rotor import data_path, load_model
     r = load_model(data_path("rotor.toml"))

@@ -221,7 +221,7 @@ def test_friswell_example_5_9_1():
 
 def test_campbell_forward_rises_backward_falls():
     r = friswell_rotor()
-    cb = r.campbell(rpm_to_rad_s(np.array([0.0, 2000.0, 4000.0])), n=4)
+    cb = r.campbell(rpm_to_rad_s(np.array([0.0, 2000.0, 4000.0])), n_modes=4)
     fw = cb.frequencies_hz[:, 3]   # second forward mode
     bw = cb.frequencies_hz[:, 2]
     assert fw[0] < fw[1] < fw[2] and bw[0] > bw[1] > bw[2]

@@ -5,8 +5,8 @@ the bearings, exciter and damping of ``mutext/data/rotor.toml``, prints the
 natural frequencies (Hz) at the sweep speed (10 Hz rotation) and the
 frequency response from the exciter current (station 12, A) to the exciter
 sensor (station 13, m) over the measured band 20-225 Hz, the healthy rotor's
-Campbell diagram (0-6000 rpm: the mode frequencies and the 1x forward critical
-speeds, :func:`mutext.rotor.campbell`) and the orbit at the sensor station
+Campbell diagram (0-6000 rpm: the mode frequencies and the forward critical speeds of the
+1x, 2x and 3x lines, :func:`mutext.rotor.campbell`) and the orbit at the sensor station
 for an unbalance at the crack station at the sweep speed
 (:func:`mutext.rotor.unbalance_response`, :func:`mutext.rotor.orbit`).
 
@@ -95,10 +95,11 @@ def solve(model_path=None, *, n_modes=6, points=400, band=(20.0, 225.0)):
     from ..rotor.orbits import orbit
     from ..rotor.unbalance import unbalance_response
     rpm = np.linspace(0.0, 6000.0, 13)
-    cd = campbell(r, rpm * np.pi / 30.0, n_modes=4, orders=(1,))
+    cd = campbell(r, rpm * np.pi / 30.0, n_modes=4, orders=(1, 2, 3))
     out["campbell"] = {"speeds_rpm": [float(x) for x in rpm],
                        "frequencies_hz": [[float(x) for x in row] for row in cd.frequencies_hz],
-                       "critical_speeds_1x_forward": [c.to_dict() for c in cd.critical_speeds(1, "forward")]}
+                       **{f"critical_speeds_{k}x_forward": [c.to_dict() for c in cd.critical_speeds(k, "forward")]
+                          for k in (1, 2, 3)}}
     ub = UNBALANCE
     u = unbalance_response(r, ub["station"], ub["kg_m"], [r.speed], [ub["probe"]])
     orb = orbit({1: (complex(u.X[0, 0]), complex(u.Y[0, 0]))}, r.speed, label=f"station {ub['probe']}")
@@ -159,9 +160,10 @@ def run(args) -> int:
         cb = out["campbell"]
         print("Campbell (healthy) [Hz] at " + ", ".join(f"{x:.0f}" for x in cb["speeds_rpm"][::4]) + " rpm: "
               + "; ".join(", ".join(f"{x:.1f}" for x in row) for row in cb["frequencies_hz"][::4]))
-        crit = cb["critical_speeds_1x_forward"]
-        print("1x forward critical speeds (0-6000 rpm): " + (", ".join(
-            f"{c['speed_rpm']:.0f} rpm ({c['frequency_hz']:.1f} Hz)" for c in crit) or "none"))
+        for k in (1, 2, 3):
+            crit = cb[f"critical_speeds_{k}x_forward"]
+            print(f"{k}x forward critical speeds (0-6000 rpm): " + (", ".join(
+                f"{c['speed_rpm']:.0f} rpm ({c['frequency_hz']:.1f} Hz)" for c in crit) or "none"))
         o = out["orbit"]
         print(f"orbit at station {o['probe']} ({o['kg_m'] * 1e6:g} g mm unbalance at station {o['station']}, "
               f"{o['speed_rpm']:.0f} rpm): ellipse {o['semi_major_m'] * 1e6:.3g} x {o['semi_minor_m'] * 1e6:.3g} um, "
@@ -212,21 +214,11 @@ def save_plots(out, directory):
     fig.savefig(files[0], dpi=120)
     plt.close(fig)
 
+    from .. import plots
+    from ..rotor.campbell_diagram import campbell
     r = out["rotors"]["healthy"]
-    speeds = np.linspace(0.0, 2 * np.pi * 100.0, 21)  # 0-6000 rpm
-    cb = r.campbell(speeds, n=6)
-    fig, ax = plt.subplots(figsize=(7, 5))
-    for j in range(cb.frequencies_hz.shape[1]):
-        fw = cb.whirl[:, j] > 0
-        ax.plot(cb.speeds_rpm[fw], cb.frequencies_hz[fw, j], "b^", ms=4)
-        ax.plot(cb.speeds_rpm[~fw], cb.frequencies_hz[~fw, j], "rv", ms=4)
-    ax.plot(cb.speeds_rpm, cb.speeds_rpm / 60.0, "k-", lw=0.8, label="1x")
-    ax.plot([], [], "b^", label="forward")
-    ax.plot([], [], "rv", label="backward")
-    ax.set_xlabel("speed [rpm]")
-    ax.set_ylabel("natural frequency [Hz]")
-    ax.set_title("Campbell diagram, healthy thesis rotor")
-    ax.legend(loc="center left")
+    cd = campbell(r, np.linspace(0.0, 2 * np.pi * 100.0, 41), n_modes=6, orders=(1, 2, 3))  # 0-6000 rpm
+    fig = plots.campbell_figure(cd, title="Campbell diagram, healthy thesis rotor (1x, 2x, 3x)")
     files.append(os.path.join(directory, "rotor_campbell.png"))
     fig.tight_layout()
     fig.savefig(files[1], dpi=120)

@@ -1,4 +1,5 @@
-r"""Analyses of an assembled model: modes, Campbell diagram, FRFs, state space.
+r"""Analyses of an assembled model: modes, FRFs, state space (the Campbell diagram is in
+:mod:`mutext.rotor.campbell_diagram`, built on :func:`modes`).
 
 All inputs and outputs are SI: frequencies in Hz where the name says ``_hz``,
 otherwise rad/s; speeds in rad/s; displacements in m; forces in N; currents in A.
@@ -82,7 +83,7 @@ from ..lti import blas_single_thread, mck_to_ss
 from ..response import FRFMatrix
 from ._shift_invert import shift_invert_roots, state_matrix
 
-__all__ = ["Modes", "Campbell", "modes", "natural_frequencies", "campbell", "frf",
+__all__ = ["Modes", "modes", "natural_frequencies", "frf",
            "state_space", "whirl_index", "blas_single_thread"]
 
 
@@ -138,28 +139,6 @@ def whirl_label(w: float, threshold: float = 0.5) -> str:
     return "forward" if w > threshold else "backward" if w < -threshold else "mixed"
 
 
-
-
-@dataclass
-class Campbell:
-    """Campbell diagram data: ``frequencies_hz[i, r]`` and ``whirl[i, r]`` at ``speeds[i]`` [rad/s].
-
-    Attributes
-    ----------
-    speeds : (S,) ndarray
-        Spin speeds [rad/s].
-    frequencies_hz : (S, n) ndarray
-        Natural frequencies [Hz] of the ``n`` lowest modes at each speed (NaN where fewer).
-    whirl : (S, n) ndarray
-        Their whirl indices (+1 forward, -1 backward).
-    """
-    speeds: np.ndarray
-    frequencies_hz: np.ndarray
-    whirl: np.ndarray
-
-    @property
-    def speeds_rpm(self) -> np.ndarray:
-        return self.speeds * 60.0 / (2.0 * np.pi)
 
 
 def whirl_index(shape: np.ndarray, layout) -> float:
@@ -464,40 +443,6 @@ def natural_frequencies(model, *, speed: float | None = None, values=None, n: in
     (3, True)
     """
     return modes(model, speed=speed, values=values, n=n, matrices=matrices).frequencies_hz
-
-
-def campbell(model, speeds: Sequence[float], *, n: int = 6, values=None) -> Campbell:
-    """Natural frequencies [Hz] and whirl indices of the ``n`` lowest modes at each speed [rad/s].
-
-    The matrices are evaluated once; modes are sorted by frequency at each
-    speed (no mode tracking across crossings).
-
-    Parameters
-    ----------
-    model : Structure or Rotor
-        The assembled model, e.g. from :func:`mutext.rotor.load_model`.
-
-    speeds : sequence of float
-        Spin speeds [rad/s].
-    n : int, optional
-        Number of modes per speed.
-    values : mapping or array_like, optional
-        Parameter values: a mapping ``name -> value`` (SI) overriding nominal ones, or a full
-        vector in the order of ``parameters`` (default: nominal, see :meth:`Structure.values`).
-    """
-    speeds = _speed_array(speeds, model.name)
-    n = _check_n(n)
-    values = _values(model, values)
-    with blas_single_thread():
-        mats = model.matrices(values)
-    F = np.full((speeds.size, n), np.nan)
-    W = np.full((speeds.size, n), np.nan)
-    for i, s in enumerate(speeds):
-        md = modes(model, speed=s, matrices=mats, n=n)
-        m = md.frequencies_hz.size
-        F[i, :m] = md.frequencies_hz
-        W[i, :m] = md.whirl
-    return Campbell(speeds, F, W)
 
 
 def _ports(model, inputs, outputs):

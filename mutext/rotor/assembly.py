@@ -605,18 +605,20 @@ class Rotor(Structure):
             raise ModelError(f"{self.name}: no shaft element starts at station {station} "
                              f"(stations with one: {sorted(self._shafts)[:3]}...)") from None
 
-    def campbell(self, speeds, **kw):
-        """See :func:`mutext.rotor.analysis.campbell`.
+    def campbell(self, speeds, n_modes: int = 6, **kw):
+        """See :func:`mutext.rotor.campbell` (the Campbell diagram with its critical speeds).
 
         Parameters
         ----------
         speeds : sequence of float
             Spin speeds [rad/s].
+        n_modes : int, optional
+            Number of lowest modes kept at each speed.
         **kw
             Keyword arguments of the function referred to.
         """
-        from .analysis import campbell
-        return campbell(self, speeds, **kw)
+        from .campbell_diagram import campbell
+        return campbell(self, speeds, n_modes, **kw)
 
 
 # ---------------------------------------------------------------------------
