@@ -18,7 +18,8 @@ DEMOS = {
     "three-mass": ("mutext.demos.three_mass",
                    "model-based identification on the three-mass rig (thesis sec. 3.4): unmodeled dynamics as a mu-controller"),
     "rotor": ("mutext.demos.rotor",
-              "rotor finite-element model: natural frequencies of the healthy and cracked rotor, exciter FRF"),
+              "rotor finite-element model: natural frequencies, exciter FRF, Campbell diagram (1x/2x/3x), "
+              "unbalance response, healthy and breathing-crack orbits"),
     "crack": ("mutext.demos.crack",
               "cracked rotor at speed (thesis ch. 4): breathing-crack sweep, sidebands, identification at the crack"),
 }

@@ -24,6 +24,14 @@ def test_demo_rotor_campbell_and_orbit(capsys):
         assert first["speed_rpm"] == pytest.approx(60.0 / k * first["frequency_hz"], rel=1e-3)
         assert first["frequency_hz"] == pytest.approx(out["natural_frequencies_hz"]["healthy"][1], rel=0.01)
         assert first["speed_rpm"] == pytest.approx(crit[0]["speed_rpm"] / k, rel=0.01)
+    # the unbalance response peaks at the 1x forward critical speed (grid of 18 rpm); a little below the
+    # 2x critical speed the breathing crack's 2x response dominates the orbit and makes an inner loop
+    ub, br = out["unbalance"], out["breathing_orbit"]
+    assert ub["peak_rpm"] == pytest.approx(crit[0]["speed_rpm"], abs=18.0)
+    assert ub["peak_m"] == pytest.approx(max(ub["amplitude_m"]))
+    a = br["amplitude_m"]
+    assert a["2x"] > 3 * max(a["1x"], a["3x"]) and a["1x"] > br["healthy_1x_m"]
+    assert br["loops"] >= 1
     # orbit: isotropic bearings give a forward circle of radius |H(F15 -> x13)| U Omega^2
     from mutext.rotor import data_path, load_model
     r = load_model(data_path("rotor.toml"))

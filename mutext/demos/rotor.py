@@ -40,7 +40,7 @@ def add_arguments(p):
         The subcommand's parser.
     """
     p.add_argument("--json", action="store_true", help="print one JSON object instead of a report")
-    p.add_argument("--plots", metavar="DIR", help="save the FRF and Campbell diagram (PNG) in DIR")
+    p.add_argument("--plots", metavar="DIR", help="save the FRF, Campbell diagram, unbalance response and orbits (PNG) in DIR")
     p.add_argument("--model", metavar="TOML", help="model file (default: mutext/data/rotor.toml)")
     p.add_argument("--modes", type=int, default=6, help="number of natural frequencies to report (default 6)")
     p.add_argument("--points", type=int, default=400, help="FRF frequencies in 20-225 Hz (default 400)")
@@ -106,12 +106,49 @@ def solve(model_path=None, *, n_modes=6, points=400, band=(20.0, 225.0)):
     e = orb.ellipse(1)
     out["orbit"] = {**ub, "speed_rpm": r.speed * 30.0 / np.pi, "semi_major_m": float(e.semi_major),
                     "semi_minor_m": float(e.semi_minor), "direction": e.direction}
+    out.update(_unbalance_and_breathing(model_path, r, cd))
     out["speed_rpm"] = r.speed * 60.0 / (2.0 * np.pi)
     out["bearing_stiffness_n_per_m"] = r.parameter("bearing2.k").value
     out["force_per_ampere_n_per_a"] = r.parameter("exciter12.ki").value
     out["note"] = CRACKED_NOTE
     out["assumptions"] = ASSUMED
     out["seconds"] = time.perf_counter() - t0
+    return out
+
+
+def _unbalance_and_breathing(model_path, healthy, cd) -> dict:
+    """The unbalance response over 60-6000 rpm (1x, healthy rotor) and, a little below the 2x forward
+    critical speed (where the 2x response of a breathing crack resonates), the orbits of the healthy rotor
+    and of the same rotor with the rig's breathing crack (weight and unbalance, harmonic balance)."""
+    from ..errors import ModelError
+    from ..examples.cracked_rotor import cracked_rotor
+    from ..rotor.periodic_orbit import periodic_unbalance_response
+    from ..rotor.unbalance import unbalance_response
+    ub = UNBALANCE
+    rpm = np.linspace(60.0, 6000.0, 331)
+    resp = unbalance_response(healthy, ub["station"], ub["kg_m"], rpm * np.pi / 30.0, [ub["probe"]])
+    s_pk, a_pk = resp.peak(0)
+    out = {"unbalance": {**ub, "peak_rpm": s_pk * 30.0 / np.pi, "peak_m": a_pk,
+                         "speeds_rpm": [float(x) for x in rpm],
+                         "amplitude_m": [float(x) for x in resp.amplitude[:, 0]]},
+           "_unbalance_response": resp, "_critical_1x": cd.critical_speeds(1, "forward")}
+    two = cd.critical_speeds(2, "forward")
+    if not two:
+        out["breathing_orbit"] = {"skipped": "no 2x forward critical speed in 0-6000 rpm"}
+        return out
+    speed = 0.93 * two[0].speed
+    try:
+        cracked = periodic_unbalance_response(cracked_rotor(model_path=model_path), speed, [ub["probe"]],
+                                              unbalance=(ub["station"], ub["kg_m"]), harmonics=4)
+    except ModelError as exc:      # a model file without the rig's crack station
+        out["breathing_orbit"] = {"skipped": f"the rig's crack does not fit this model ({exc})"}
+        return out
+    plain = unbalance_response(healthy, ub["station"], ub["kg_m"], [speed], [ub["probe"]])
+    orbit = cracked.orbit(0)
+    out["breathing_orbit"] = {"speed_rpm": speed * 30.0 / np.pi, "probe": ub["probe"],
+                              "amplitude_m": {f"{k}x": cracked.amplitude(k) for k in (1, 2, 3)},
+                              "healthy_1x_m": float(plain.amplitude[0, 0]), "loops": orbit.loops()}
+    out["_orbits"] = [plain.orbit(0), orbit]
     return out
 
 
@@ -135,7 +172,8 @@ def run(args) -> int:
     if args.json:
         from ..jsonio import print_json
         keys = ("natural_frequencies_hz", "whirl", "frf_peaks_hz", "frf_antiresonances_hz", "speed_rpm",
-                "bearing_stiffness_n_per_m", "force_per_ampere_n_per_a", "campbell", "orbit", "note",
+                "bearing_stiffness_n_per_m", "force_per_ampere_n_per_a", "campbell", "orbit", "unbalance",
+                "breathing_orbit", "note",
                 "assumptions", "seconds")
         print_json({k: out[k] for k in keys})
     else:
@@ -168,6 +206,18 @@ def run(args) -> int:
         print(f"orbit at station {o['probe']} ({o['kg_m'] * 1e6:g} g mm unbalance at station {o['station']}, "
               f"{o['speed_rpm']:.0f} rpm): ellipse {o['semi_major_m'] * 1e6:.3g} x {o['semi_minor_m'] * 1e6:.3g} um, "
               f"{o['direction']}")
+        u = out["unbalance"]
+        print(f"unbalance response at station {u['probe']} (60-6000 rpm): peak {u['peak_m'] * 1e6:.3g} um at "
+              f"{u['peak_rpm']:.0f} rpm (the 1x forward critical speed)")
+        b = out["breathing_orbit"]
+        if "skipped" in b:
+            print(f"breathing-crack orbit: skipped ({b['skipped']})")
+        else:
+            a = b["amplitude_m"]
+            print(f"breathing crack (rig's, a/D 0.4 at station 15) at {b['speed_rpm']:.0f} rpm, station {b['probe']}: "
+                  + ", ".join(f"{k} {v * 1e6:.3g} um" for k, v in a.items())
+                  + f" (healthy 1x {b['healthy_1x_m'] * 1e6:.3g} um); the orbit crosses itself "
+                  f"{b['loops']} time(s)")
         print(f"time: {out['seconds']:.2f} s")
     if args.plots:
         files = save_plots(out, args.plots)
@@ -176,7 +226,8 @@ def run(args) -> int:
 
 
 def save_plots(out, directory):
-    """FRF (magnitude and phase) of both rotors and the healthy rotor's Campbell diagram, as PNG files.
+    """PNG files: the FRF (magnitude and phase) of both rotors, the healthy rotor's Campbell diagram (1x,
+    2x, 3x) and unbalance response (Bode), and the orbits of the healthy and the breathing-cracked rotor.
 
     Parameters
     ----------
@@ -220,7 +271,19 @@ def save_plots(out, directory):
     cd = campbell(r, np.linspace(0.0, 2 * np.pi * 100.0, 41), n_modes=6, orders=(1, 2, 3))  # 0-6000 rpm
     fig = plots.campbell_figure(cd, title="Campbell diagram, healthy thesis rotor (1x, 2x, 3x)")
     files.append(os.path.join(directory, "rotor_campbell.png"))
-    fig.tight_layout()
-    fig.savefig(files[1], dpi=120)
+    fig.savefig(files[-1], dpi=120)
+    plt.close(fig)
+    fig = plots.unbalance_bode_figure(out["_unbalance_response"], critical=out["_critical_1x"],
+                                      title=f"unbalance {UNBALANCE['kg_m'] * 1e6:g} g mm at station "
+                                            f"{UNBALANCE['station']}, healthy rotor")
+    files.append(os.path.join(directory, "rotor_unbalance.png"))
+    if "_orbits" in out:
+        fig.savefig(files[-1], dpi=120)
+        plt.close(fig)
+        rpm = out["breathing_orbit"]["speed_rpm"]
+        fig = plots.orbit_figure(out["_orbits"], titles=[f"healthy, 1x, {rpm:.0f} rpm",
+                                                         f"breathing crack, {rpm:.0f} rpm"])
+        files.append(os.path.join(directory, "rotor_orbits.png"))
+    fig.savefig(files[-1], dpi=120)
     plt.close(fig)
     return files

@@ -12,6 +12,8 @@ element), available as :func:`thesis_cracked_table_rotor`.
 """
 from __future__ import annotations
 
+import os
+
 from ..rotor import data_path, load_model, loads_model
 from ..rotor.crack import RIG_CRACK_DEPTH_RATIO, RIG_CRACK_STATION
 
@@ -33,7 +35,7 @@ def healthy_rotor():
 
 
 def cracked_rotor(depth_ratio: float = RIG_CRACK_DEPTH_RATIO, *, breathing: str | None = "mayes",
-                  station: int = RIG_CRACK_STATION, orientation: float = 0.0):
+                  station: int = RIG_CRACK_STATION, orientation: float = 0.0, model_path=None):
     """The healthy rotor with a crack element (default: the rig's, breathing by the Mayes law).
 
     ``breathing=None`` gives an open crack facing ``orientation`` (time-invariant).
@@ -48,15 +50,18 @@ def cracked_rotor(depth_ratio: float = RIG_CRACK_DEPTH_RATIO, *, breathing: str 
         Station where the cracked shaft element starts (1-based, the thesis's numbering).
     orientation : float, optional
         Angle [rad] of the open crack's normal from x (``breathing=None`` only).
+    model_path : str or path-like, optional
+        The healthy rotor's model file (default: ``mutext/data/rotor.toml``).
     """
     extra = f"\n[[crack]]\nstation = {int(station)}\ndepth_ratio = {float(depth_ratio)!r}\n" \
             f"orientation = {float(orientation)!r}\n"
     if breathing is not None:
         extra += f"breathing = {breathing!r}\n"
-    path = data_path("rotor.toml")
+    path = os.fspath(model_path) if model_path is not None else data_path("rotor.toml")
     with open(path, encoding="utf-8") as fh:
         text = fh.read()
-    return loads_model(text + extra, source=f"{path} + crack at station {station}", base_dir=data_path(""))
+    return loads_model(text + extra, source=f"{path} + crack at station {station}",
+                       base_dir=os.path.dirname(os.path.abspath(path)))
 
 
 def thesis_cracked_table_rotor():
