@@ -10,7 +10,7 @@ bearings of 1 MN/m and 100 N s/m at the ends), the CPU times of
   elements and ``Rotor``, which assembles the matrices);
 * modal at 0 and at 4000 rpm, the lowest ``--modes`` modes: mutext's default
   ``Rotor.modes(speed=..., n=...)`` (``method="auto"``: the dense eigen-decomposition,
-  or from 400 DOFs up the sparse shift-invert solve) and the sparse shift-invert
+  or from 150 DOFs up the sparse shift-invert solve) and the sparse shift-invert
   ``mutext.rotor.sparse_modal.sparse_modes`` always, against ROSS's
   ``rotor.run_modal(speed, num_modes=2 n)`` (which returns ``n`` modes);
 * FRF at 4000 rpm on ``--nfreq`` frequencies (2-200 Hz), force in x at the first
@@ -37,6 +37,16 @@ the ROSS process).  Imports and the interpreter start are not timed.  A sparse
 solve that ARPACK does not finish at shift 0 is repeated at other shifts within the
 timed run (counted in the output).  The default run takes some 5 CPU minutes,
 most of them ROSS's FRF on 200 elements.
+
+Measured (default options, both sides in one session on 2 shared cores; ratios mutext/ROSS of the
+median process CPU time, below 1: mutext is faster)::
+
+    rotor         DOFs (mutext/ROSS)  build  modes() 0 rpm  sparse 0  modes() 4000  sparse 4000   FRF
+    6 elements        28 / 42         0.31       0.13        0.23        0.34         0.44       0.25
+    48 elements      196 / 294        0.59       0.14        0.15        0.20         0.17       0.11
+    200 elements     804 / 1206       0.63       0.03        0.02        0.03         0.04       0.08
+
+Natural frequencies agree to 9.1e-10 and the FRF to 2.0e-10 (relative).
 
 ROSS 3.1 needs Python >= 3.13, so it runs in its own environment, in a
 subprocess (the script ``ROSS_SCRIPT`` below, JSON in and out)::
