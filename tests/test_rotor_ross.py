@@ -41,7 +41,8 @@ print(json.dumps(out))
 def test_campbell_friswell_against_ross():
     python = bench_ross.ross_python()
     if python is None or not Path(python).exists():
-        pytest.skip("ROSS 3.1 needs Python >= 3.13: make /work/main/.venv-ross (see benchmarks/bench_ross.py) "
+        venv = Path(__file__).resolve().parents[1] / ".venv-ross"
+        pytest.skip(f"ROSS 3.1 needs Python >= 3.13: make {venv} (see benchmarks/bench_ross.py) "
                     "or set MUTEXT_ROSS_PYTHON")
     from mutext.examples.friswell import rotor
     from mutext.rotor import campbell
