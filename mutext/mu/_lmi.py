@@ -176,14 +176,23 @@ def _lmi_problem(S: BlockStructure, use_g: bool) -> _LMIProblem:
                           "use method='osborne'") from None
 
 
-def _eigvals_scaled(M) -> np.ndarray:
-    """Eigenvalues of ``M`` computed on ``M / max|M_ij|``: LAPACK's eigenvalue iteration does not
-    converge on some matrices of entries near 1e-35 with parts near 1e-51 (``mu_sweep`` at
-    omega = 2e17), which it solves at unit scale."""
-    s = float(np.abs(M).max(initial=0.0))
-    if not (s > 0 and np.isfinite(s)):
+def _eigvals_robust(M) -> np.ndarray:
+    """Eigenvalues of ``M``, for the cheap lower bounds.  LAPACK's QR iteration does not converge on a
+    few matrices (``mu_sweep`` at omega = 2e17: entries near 1e-18 and 1e-35 with parts near 1e-51;
+    scaling by a power of two does not help, the failure follows the bits); then those of ``M``
+    divided by its largest entry (the same eigenvalues, other rounding on the way), and if that
+    fails too none: the bound from this term is then 0, still a lower bound."""
+    try:
         return np.linalg.eigvals(M)
-    return np.linalg.eigvals(M / s) * s
+    except np.linalg.LinAlgError:
+        pass
+    s = float(np.abs(M).max(initial=0.0))
+    if s > 0 and np.isfinite(s):
+        try:
+            return np.linalg.eigvals(M / s) * s
+        except np.linalg.LinAlgError:
+            pass
+    return np.zeros(0, complex)
 
 
 def _easy_lower(M, S: BlockStructure) -> float:
@@ -195,12 +204,12 @@ def _easy_lower(M, S: BlockStructure) -> float:
         if b.kind == "full":
             best = max(best, np.linalg.norm(Mk, 2))
         else:
-            ev = _eigvals_scaled(Mk)
+            ev = _eigvals_robust(Mk)
             if b.kind == "real":
                 ev = ev[np.abs(ev.imag) <= 1e-12 * np.abs(ev)]
             best = max(best, np.abs(ev).max(initial=0.0))
     if not S.has_real and all(b.rows == b.cols for b in S.blocks):
-        best = max(best, np.abs(_eigvals_scaled(M)).max())
+        best = max(best, np.abs(_eigvals_robust(M)).max(initial=0.0))
     return float(best)
 
 
