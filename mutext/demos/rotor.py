@@ -40,7 +40,8 @@ def add_arguments(p):
         The subcommand's parser.
     """
     p.add_argument("--json", action="store_true", help="print one JSON object instead of a report")
-    p.add_argument("--plots", metavar="DIR", help="save the FRF, Campbell diagram, unbalance response and orbits (PNG) in DIR")
+    p.add_argument("--plots", metavar="DIR",
+                   help="save the FRF, Campbell diagram, unbalance response and orbits (PNG) in DIR")
     p.add_argument("--model", metavar="TOML", help="model file (default: mutext/data/rotor.toml)")
     p.add_argument("--modes", type=int, default=6, help="number of natural frequencies to report (default 6)")
     p.add_argument("--points", type=int, default=400, help="FRF frequencies in 20-225 Hz (default 400)")
@@ -249,6 +250,13 @@ def save_plots(out, directory):
         os.remove(probe)
     except OSError as exc:
         raise ModelError(f"--plots {directory!r}: cannot write plots there ({exc.strerror or exc})") from None
+    files = []
+
+    def save(fig, name):
+        files.append(os.path.join(directory, name))
+        fig.savefig(files[-1], dpi=120)
+        plt.close(fig)
+
     f = out["freqs_hz"]
     fig, (a1, a2) = plt.subplots(2, 1, sharex=True, figsize=(7, 6))
     for key, style in (("healthy", "-"), ("cracked", "--")):
@@ -260,30 +268,19 @@ def save_plots(out, directory):
     a2.set_xlabel("frequency [Hz]")
     a1.legend()
     a1.set_title("exciter current (station 12) to sensor (station 13)")
-    files = [os.path.join(directory, "rotor_frf.png")]
     fig.tight_layout()
-    fig.savefig(files[0], dpi=120)
-    plt.close(fig)
+    save(fig, "rotor_frf.png")
 
     from .. import plots
     from ..rotor.campbell_diagram import campbell
     r = out["rotors"]["healthy"]
     cd = campbell(r, np.linspace(0.0, 2 * np.pi * 100.0, 41), n_modes=6, orders=(1, 2, 3))  # 0-6000 rpm
-    fig = plots.campbell_figure(cd, title="Campbell diagram, healthy thesis rotor (1x, 2x, 3x)")
-    files.append(os.path.join(directory, "rotor_campbell.png"))
-    fig.savefig(files[-1], dpi=120)
-    plt.close(fig)
-    fig = plots.unbalance_bode_figure(out["_unbalance_response"], critical=out["_critical_1x"],
-                                      title=f"unbalance {UNBALANCE['kg_m'] * 1e6:g} g mm at station "
-                                            f"{UNBALANCE['station']}, healthy rotor")
-    files.append(os.path.join(directory, "rotor_unbalance.png"))
+    save(plots.campbell_figure(cd, title="Campbell diagram, healthy thesis rotor (1x, 2x, 3x)"), "rotor_campbell.png")
+    save(plots.unbalance_bode_figure(out["_unbalance_response"], critical=out["_critical_1x"],
+                                     title=f"unbalance {UNBALANCE['kg_m'] * 1e6:g} g mm at station "
+                                           f"{UNBALANCE['station']}, healthy rotor"), "rotor_unbalance.png")
     if "_orbits" in out:
-        fig.savefig(files[-1], dpi=120)
-        plt.close(fig)
         rpm = out["breathing_orbit"]["speed_rpm"]
-        fig = plots.orbit_figure(out["_orbits"], titles=[f"healthy, 1x, {rpm:.0f} rpm",
-                                                         f"breathing crack, {rpm:.0f} rpm"])
-        files.append(os.path.join(directory, "rotor_orbits.png"))
-    fig.savefig(files[-1], dpi=120)
-    plt.close(fig)
+        save(plots.orbit_figure(out["_orbits"], titles=[f"healthy, 1x, {rpm:.0f} rpm",
+                                                        f"breathing crack, {rpm:.0f} rpm"]), "rotor_orbits.png")
     return files
