@@ -139,8 +139,6 @@ def whirl_label(w: float, threshold: float = 0.5) -> str:
     return "forward" if w > threshold else "backward" if w < -threshold else "mixed"
 
 
-
-
 def whirl_index(shape: np.ndarray, layout) -> float:
     """Whirl index of one mode shape (see the module docstring); NaN unless a two-plane rotor.
 
