@@ -5,6 +5,8 @@ Reference values: Skogestad and Postlethwaite, *Multivariable Feedback Control*,
 mu(a b^H) = sum |a_i b_i| for complex scalar blocks; Packard and Doyle (1993)
 for the exactness of the D-scaling bound when 2S + F <= 3.
 """
+import os
+
 import numpy as np
 import pytest
 from hypothesis import given, settings
@@ -319,8 +321,13 @@ def lower_never_exceeds_upper(spec, seed, real_matrix):
         check_lower(M, S, lo)
 
 
-# ten random draws in the default run (30 took 16-34 CPU s, as the draws fell); 200 with the slow tests
-@settings(max_examples=10, deadline=None, database=None)
+# ten draws in the default run (30 took 16-34 CPU s, as the draws fell); 200 with the slow tests.
+# Derandomised (the same draws every run, so either can gate a submission) unless
+# MUTEXT_EXPLORE=1, which draws new ones to look for new failures
+EXPLORE = os.environ.get("MUTEXT_EXPLORE", "") not in ("", "0")
+
+
+@settings(max_examples=10, deadline=None, database=None, derandomize=not EXPLORE)
 @given(spec=st.lists(block_strategy(), min_size=1, max_size=3), seed=st.integers(0, 2 ** 32 - 1),
        real_matrix=st.booleans())
 def test_lower_never_exceeds_upper(spec, seed, real_matrix):
@@ -328,11 +335,47 @@ def test_lower_never_exceeds_upper(spec, seed, real_matrix):
 
 
 @pytest.mark.slow
-@settings(max_examples=200, deadline=None, database=None)
+@settings(max_examples=200, deadline=None, database=None, derandomize=not EXPLORE)
 @given(spec=st.lists(block_strategy(), min_size=1, max_size=5), seed=st.integers(0, 2 ** 32 - 1),
        real_matrix=st.booleans())
 def test_lower_never_exceeds_upper_many(spec, seed, real_matrix):
     lower_never_exceeds_upper(spec, seed, real_matrix)
+
+
+def exact_dg_level(M, Dl, Dr, G, dps=50):
+    """The certificate level of (Dl, Dr, G) in 50-digit arithmetic: the square root of the largest
+    eigenvalue of Dr^{-1/2} (M^H Dl M + j(G M - M^H G^H)) Dr^{-1/2} (written here apart from the
+    package's evaluation)."""
+    import mpmath as mp
+    with mp.workdps(dps):
+        m = lambda X: mp.matrix(np.asarray(X, complex).tolist())
+        Mm, L, R = m(M), m(Dl), m(Dr)
+        X = Mm.H * L * Mm
+        if G is not None:
+            X = X + 1j * (m(G) * Mm - Mm.H * m(G).H)
+        ev, Q = mp.eigh(R)
+        Ri = Q * mp.diag([1 / mp.sqrt(e) for e in ev]) * Q.H
+        Y = Ri * X * Ri
+        lam = max(mp.re(e) for e in mp.eigh((Y + Y.H) / 2, eigvals_only=True))
+        return float(mp.sqrt(max(lam, 0)))
+
+
+def test_ill_conditioned_certificate_is_not_below_mu():
+    """Two repeated real scalars where the LMI's optimal scalings are nearly singular (condition
+    2e8) and its G large: in double precision their level came out 1.1e-8 below a true lower bound
+    on mu (a real perturbation making I - M Delta singular); the bound must be the exact level of
+    the scalings it returns, rounded up."""
+    S = make_structure([("real", 2, 0), ("real", 2, 0)])
+    M = crandn(np.random.default_rng(264044010), S.ncols, S.nrows)
+    lo = mu_lower(M, S)
+    check_lower(M, S, lo)
+    up = mu_upper(M, S, lower=lo.value)
+    exact = exact_dg_level(M, up.Dl, up.Dr, up.G)
+    assert exact >= lo.value * (1 - 1e-12)        # the mathematics: any certificate is above mu
+    assert up.value >= exact                       # the bound reported is the certificate's, not less
+    assert up.value == pytest.approx(exact, rel=1e-12)
+    assert up.value >= lo.value
+    assert dg_bound(M, S, up.Dl, up.Dr, up.G) >= exact
 
 
 def test_lower_bound_of_zero_matrix():

@@ -69,31 +69,103 @@ def _pow2_scale(A) -> float:
     return float(np.ldexp(1.0, min(max(-int(np.frexp(a)[1]), -1000), 1000)))   # 2**1073 would overflow
 
 
-def _gevp(M, Dl, Dr, G, S: BlockStructure) -> float:
-    r"""Smallest :math:`\beta\ge 0` with :math:`M^HD_\ell M + j(GM - M^HG^H) \preceq \beta^2 D_r`.
+def _rounding_margin(A, Gt) -> float:
+    r"""A bound on the rounding error of the largest eigenvalue of
+    :math:`A^HA + j(\tilde GA - A^H\tilde G^H)` as computed in floating point: forming
+    the products errs by at most :math:`n\varepsilon|A|^H|A|` and
+    :math:`n\varepsilon|\tilde G||A|` entrywise, and a backward-stable eigensolver adds
+    :math:`p(n)\varepsilon\|H\|` (Weyl), both below :math:`4n\varepsilon(\|A\|_F^2 +
+    2\|\tilde G\|_F\|A\|_F)`.  A few :math:`\varepsilon` of the value where the scalings are
+    well conditioned; where a solver's scalings are nearly singular and its :math:`G` large,
+    terms of 1e12 cancel to an eigenvalue of 1 and the double-precision value can sit below a
+    true lower bound on :math:`\mu` (seen: by 1.1e-8 relative)."""
+    n = A.shape[0] + A.shape[1]
+    a = float(np.linalg.norm(A))
+    g = 0.0 if Gt is None else float(np.linalg.norm(Gt))
+    return 4.0 * n * np.finfo(float).eps * (a * a + 2.0 * g * a)
 
-    Evaluated as the largest eigenvalue of
-    :math:`A^HA + j(\tilde G A - A^H\tilde G^H)` with :math:`A = D_\ell^{1/2}MD_r^{-1/2}`
-    and :math:`\tilde G = D_r^{-1/2}GD_\ell^{-1/2}` (a congruence by
-    :math:`D_r^{-1/2}`), the square roots taken block by block; ``inf`` when a
-    scaling is not positive definite.
-    """
+
+# relative rounding margin above which the certificate is recomputed in extended precision
+_MARGIN_RTOL = 1e-12
+
+
+def _gevp_mp(M, Dl, Dr, G, dps: int = 40) -> float:
+    r"""The generalised eigenvalue of :func:`_gevp` in ``dps``-digit arithmetic (mpmath),
+    rounded up to the next double: the certificate of given double-precision scalings to the
+    last bit, whatever their conditioning (a few ms for 8 x 8; used only where the rounding
+    margin of the double-precision evaluation matters)."""
+    import mpmath as mp
+    with mp.workdps(dps):
+        Mm, L, R = (mp.matrix(np.asarray(X, complex).tolist()) for X in (M, Dl, Dr))
+        X = Mm.H * L * Mm
+        if G is not None:
+            Gm = mp.matrix(np.asarray(G, complex).tolist())
+            GM = Gm * Mm
+            X = X + 1j * (GM - GM.H)
+        E, Q = mp.eigh(0.5 * (R + R.H))
+        if min(mp.re(e) for e in E) <= 0:
+            return np.inf
+        Rih = Q * mp.diag([1 / mp.sqrt(mp.re(e)) for e in E]) * Q.H
+        Y = Rih * X * Rih
+        lam = max(mp.re(e) for e in mp.eigh(0.5 * (Y + Y.H), eigvals_only=True))
+        if lam <= 0:
+            return 0.0       # the exact inequality holds at beta = 0
+        return float(np.nextafter(float(mp.sqrt(lam)), np.inf))
+
+
+def _gevp_fast(M, Dl, Dr, G, S: BlockStructure) -> tuple[float, float]:
+    r"""The largest eigenvalue of :math:`A^HA + j(\tilde G A - A^H\tilde G^H)` in double
+    precision, with :math:`A = D_\ell^{1/2}MD_r^{-1/2}` and :math:`\tilde G =
+    D_r^{-1/2}GD_\ell^{-1/2}` (a congruence by :math:`D_r^{-1/2}`, square roots taken block by
+    block): ``(beta, rel)`` with ``beta`` its square root (what an optimiser compares
+    levels by) and ``rel`` the bound of :func:`_rounding_margin` on the error of
+    ``beta ** 2`` relative to it; ``(inf, 0)`` when a scaling is not positive definite."""
     Lh = _block_power(Dl, S.col_slices, 0.5)
     Ri = _block_power(Dr, S.row_slices, -0.5)
     if Lh is None or Ri is None:
-        return np.inf
+        return np.inf, 0.0
     A = Lh @ M @ Ri
     c = _pow2_scale(A)           # the value is homogeneous in (M, G): computed for (c M, c G)
     if c != 1.0:
         A = c * A
     H = A.conj().T @ A
+    Gt = None
     if G is not None:
         Lhi = _block_power(Dl, S.col_slices, -0.5)
-        GA = (c * (Ri @ G @ Lhi)) @ A
+        Gt = c * (Ri @ G @ Lhi)
+        GA = Gt @ A
         H = H + 1j * (GA - GA.conj().T)
     H = 0.5 * (H + H.conj().T)
-    lam = np.linalg.eigvalsh(H).max()
-    return float(np.sqrt(max(lam, 0.0))) / c
+    lam = max(float(np.linalg.eigvalsh(H).max()), 0.0)
+    return float(np.sqrt(lam)) / c, _relative_margin(lam, _rounding_margin(A, Gt))
+
+
+def _relative_margin(lam: float, margin: float) -> float:
+    """``margin / lam`` (0 where both vanish, inf where only the eigenvalue does)."""
+    if margin == 0.0:
+        return 0.0
+    return margin / lam if lam > 0 else np.inf
+
+
+def _gevp_certified(M, Dl, Dr, G, beta: float, rel: float) -> float:
+    """The bound from a double-precision evaluation ``(beta, rel)`` of :func:`_gevp_fast`:
+    ``beta`` with the margin added where it is negligible, the extended-precision value
+    where it is not."""
+    if not np.isfinite(beta):
+        return beta
+    if rel <= _MARGIN_RTOL:
+        return float(beta * np.sqrt(1.0 + rel))
+    return _gevp_mp(M, Dl, Dr, G)
+
+
+def _gevp(M, Dl, Dr, G, S: BlockStructure) -> float:
+    r"""Smallest :math:`\beta\ge 0` with :math:`M^HD_\ell M + j(GM - M^HG^H) \preceq \beta^2 D_r`,
+    a bound for the exact inequality: evaluated in double precision
+    (:func:`_gevp_fast`) with its rounding margin, and in extended precision where that margin
+    would show in the twelfth digit (:func:`_gevp_mp`); ``inf`` when a scaling is not positive
+    definite."""
+    beta, rel = _gevp_fast(M, Dl, Dr, G, S)
+    return _gevp_certified(M, Dl, Dr, G, beta, rel)
 
 
 def dg_bound(M, structure: BlockStructure, Dl, Dr, G=None, *, tol: float = 1e-9) -> float:

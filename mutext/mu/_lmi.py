@@ -10,7 +10,7 @@ import numpy as np
 
 from .._solver import solve
 from ..errors import SolverError
-from ._certificate import MuUpper, _d_from_matrices, _diag_result, _gevp
+from ._certificate import MuUpper, _d_from_matrices, _diag_result, _gevp, _gevp_fast
 from ._structure import BlockStructure, _per_structure
 
 
@@ -246,7 +246,7 @@ def _lmi_bisect(M, S: BlockStructure, use_g: bool, d0, lower, rtol: float, start
         if use_g:
             G = (start.G if start.G is not None else np.zeros((S.nrows, S.ncols))) / nrm \
                 / dr0[:, None] / dl0[None, :]
-        v = _gevp(Mn, Dl, Dr, G, S)
+        v = _gevp_fast(Mn, Dl, Dr, G, S)[0]
         if v < best[0]:
             best = (v, Dl, Dr, G)
             hi = v
@@ -266,8 +266,9 @@ def _lmi_bisect(M, S: BlockStructure, use_g: bool, d0, lower, rtol: float, start
         solved = True
         t, xd, xg = sol
         Dl, Dr, G = prob.scalings(xd, xg)
-        # feasibility is decided by the certificate, not by the solver's t
-        val = _gevp(Mn, Dl, Dr, G, S)
+        # feasibility is decided by the certificate, not by the solver's t: its value in double
+        # precision here (the bisection's compass), the bound with rounding accounted for below
+        val = _gevp_fast(Mn, Dl, Dr, G, S)[0]
         if val < best[0]:
             best = (val, Dl, Dr, G)
         if val <= beta * (1 + 1e-12):

@@ -6,7 +6,8 @@ from scipy.linalg.lapack import zheevd as _zheevd
 
 from .._validation import NoneOr, Options, Real, validate_params
 from ..errors import ModelError, SolverError
-from ._certificate import MuUpper, _diag_result, _gevp, _pow2_scale
+from ._certificate import (MuUpper, _diag_result, _gevp, _gevp_certified, _pow2_scale,
+                           _relative_margin, _rounding_margin)
 from ._fast import _DGParams, _fast_default, _fast_polish
 from ._lmi import _lmi_bisect
 from ._osborne import _upper_osborne
@@ -52,12 +53,16 @@ def _gevp_diagonal(M, Dl, Dr, G):
     if c != 1.0:
         A = c * A
     H = A.conj().T @ A
+    Gt = None
     if G is not None:
-        GA = ((ri[:, None] * (c * G)) / lh) @ A
+        Gt = (ri[:, None] * (c * G)) / lh
+        GA = Gt @ A
         H = H + 1j * (GA - GA.conj().T)
     w, _, info = _zheevd(H, compute_v=0)       # one triangle: H is Hermitian up to rounding
     lam = w[-1] if info == 0 else np.linalg.eigvalsh(0.5 * (H + H.conj().T))[-1]
-    return float(np.sqrt(max(lam, 0.0))) / c
+    lam = max(float(lam), 0.0)
+    return _gevp_certified(M, Dl, Dr, G, float(np.sqrt(lam)) / c,
+                           _relative_margin(lam, _rounding_margin(A, Gt)))
 
 
 def _certify(M, S: BlockStructure, up: MuUpper) -> MuUpper | None:
