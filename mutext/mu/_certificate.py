@@ -85,8 +85,9 @@ def _rounding_margin(A, Gt) -> float:
     return 4.0 * n * np.finfo(float).eps * (a * a + 2.0 * g * a)
 
 
-# relative rounding margin above which the certificate is recomputed in extended precision
-_MARGIN_RTOL = 1e-12
+# relative rounding margin (of beta**2) above which the certificate is recomputed in extended
+# precision; below it the margin is added (the bound moves by at most 5e-11 of itself)
+_MARGIN_RTOL = 1e-10
 
 
 def _gevp_mp(M, Dl, Dr, G, dps: int = 40) -> float:
@@ -161,9 +162,9 @@ def _gevp_certified(M, Dl, Dr, G, beta: float, rel: float) -> float:
 def _gevp(M, Dl, Dr, G, S: BlockStructure) -> float:
     r"""Smallest :math:`\beta\ge 0` with :math:`M^HD_\ell M + j(GM - M^HG^H) \preceq \beta^2 D_r`,
     a bound for the exact inequality: evaluated in double precision
-    (:func:`_gevp_fast`) with its rounding margin, and in extended precision where that margin
-    would show in the twelfth digit (:func:`_gevp_mp`); ``inf`` when a scaling is not positive
-    definite."""
+    (:func:`_gevp_fast`) with its rounding margin, and in extended precision where that
+    margin would move it by more than 5e-11 of itself (:func:`_gevp_mp`); ``inf`` when a
+    scaling is not positive definite."""
     beta, rel = _gevp_fast(M, Dl, Dr, G, S)
     return _gevp_certified(M, Dl, Dr, G, beta, rel)
 
@@ -200,6 +201,11 @@ def dg_bound(M, structure: BlockStructure, Dl, Dr, G=None, *, tol: float = 1e-9)
     Returns
     -------
     float
+        The smallest such :math:`\beta` for the exact inequality: rounding is accounted for
+        (a bound on the error of the double-precision evaluation is added, and where it
+        would move the value by more than 5e-11 of itself the level is computed in 40-digit
+        arithmetic), so that nearly singular scalings with a large :math:`G` cannot
+        return a value below :math:`\mu`.
 
     Raises
     ------
