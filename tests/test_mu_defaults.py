@@ -48,6 +48,22 @@ def test_default_equals_ab13md(k, variant):
             assert up.value == pytest.approx(lmi.value, rel=1e-5)
 
 
+def test_stationary_point_at_a_kink_ends_the_descent():
+    """Two real scalars whose optimum is a kink of lambda_max: there the model of the two top
+    eigenvalues predicts no decrease, and the descent used to alternate between that model and
+    a failing 30-point line search until its budget was spent (377 evaluations for the same
+    value as 29)."""
+    ab13md = pytest.importorskip("slycot").ab13md
+    S = BlockStructure([Block.real(), Block.real()])
+    M = (np.array([[-0.8860281186981614, -0.4441434310080034], [-1.543707349779808, -0.15083738763813545]])
+         + 1j * np.array([[-1.1927506719479888, 0.2686128958988119], [1.7950324347288145, 0.4722904432030432]]))
+    up = mu_upper(M, S)
+    _certified(M, S, up)
+    ref = ab13md(M, np.array([1, 1]), np.array([1, 1]))[0]
+    assert up.value == pytest.approx(ref, rel=1e-8)
+    assert up.iterations < 100
+
+
 @pytest.mark.parametrize("blocks", [
     [Block.scalar(2), Block.full(1), Block.full(2)],          # repeated complex scalar
     [Block.scalar(3), Block.scalar(1), Block.full(1, 2)],

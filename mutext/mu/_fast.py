@@ -384,6 +384,12 @@ def _bfgs(fun, x0, B0=None, max_iter: int = 100, ftol: float = 1e-10, max_step: 
             break
         if kinked and not cl_fail and cl is not None and 1.0 - cl[0] < _CLUSTER_GAP:
             d, pred = _cluster_step(cl, B)
+            if pred >= 0.0 and np.all(np.isfinite(d)):
+                # the model of the two top eigenvalues has its minimum here (a stationary point
+                # of lambda_max): without this stop a failing line search along -B g and this
+                # step alternated until the evaluation budget was spent
+                stop = "ftol"
+                break
             if pred < 0 and np.all(np.isfinite(d)):
                 big = np.abs(d).max()
                 t = min(1.0, max_step / big) if big > 0 else 1.0
