@@ -64,6 +64,25 @@ def test_stationary_point_at_a_kink_ends_the_descent():
     assert up.iterations < 100
 
 
+def test_fast_bound_is_the_one_its_scalings_prove():
+    """A repeated real scalar where the fast descent drives its scalings nearly singular (a
+    factor of e^-12) with G near 1e7: its value in double precision was 7.5e-6 below the optimal
+    D-G bound (the LMI's); what method="fast" returns is the bound of its scalings."""
+    S = BlockStructure([Block.real(2), Block.full(1)])
+    M = np.array([[0.42813233573262155, 1.0662820712472592, -0.30711277629508793],
+                  [0.590319126139945, 0.3875266003869103, 0.2543950465534761],
+                  [-0.48679520481947613, 0.3623134619747169, 1.4654414362970927]]) \
+        + 1j * np.array([[-0.0667677549020829, -0.9008526731656081, 0.4774912283168824],
+                         [-0.7449089422343393, 1.1890176279230957, -0.14873434389103896],
+                         [-0.4503530214110313, 0.30578216848595874, -0.19024550452549494]])
+    fast = mu_upper(M, S, method="fast")
+    lmi = mu_upper(M, S, method="lmi")
+    _certified(M, S, fast)
+    _certified(M, S, lmi)
+    assert fast.value >= lmi.value * (1 - 1e-6)      # the LMI is within its rtol of the optimum
+    assert mu_upper(M, S).value <= lmi.value * (1 + 1e-9)
+
+
 @pytest.mark.parametrize("blocks", [
     [Block.scalar(2), Block.full(1), Block.full(2)],          # repeated complex scalar
     [Block.scalar(3), Block.scalar(1), Block.full(1, 2)],
