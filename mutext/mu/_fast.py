@@ -346,6 +346,17 @@ def _cluster_step(cl, B):
     return d, pred
 
 
+def _bfgs_update(B, s, y):
+    """The BFGS update of the inverse Hessian approximation ``B`` for the step ``s`` and the change
+    of gradient ``y`` (``B`` unchanged where the curvature ``s'y`` is not positive)."""
+    sy = float(s @ y)
+    if not sy > 1e-14 * float(s @ s):
+        return B
+    By = B @ y
+    rho = 1.0 / sy
+    return B + ((sy + y @ By) * rho * rho) * (s[:, None] * s) - rho * (By[:, None] * s + s[:, None] * By)
+
+
 def _bfgs(fun, x0, B0=None, max_iter: int = 100, ftol: float = 1e-10, max_step: float = 1.0,
           max_eval: int = 400, info: dict | None = None, cluster=None):
     r"""Minimise a (possibly nonsmooth at optimum) function by BFGS with a weak Wolfe line search.
@@ -409,12 +420,7 @@ def _bfgs(fun, x0, B0=None, max_iter: int = 100, ftol: float = 1e-10, max_step: 
                     moved = True
                     x, f, g = xt, ft, gt
                     cl = cluster()
-                    sy = float(s_ @ y_)
-                    if sy > 1e-14 * float(s_ @ s_):
-                        By = B @ y_
-                        rho = 1.0 / sy
-                        B = B + ((sy + y_ @ By) * rho * rho) * (s_[:, None] * s_) \
-                            - rho * (By[:, None] * s_ + s_[:, None] * By)
+                    B = _bfgs_update(B, s_, y_)
                     small = small + 1 if drop < ftol else 0
                     if small >= 2:
                         stop = "ftol"
@@ -474,11 +480,7 @@ def _bfgs(fun, x0, B0=None, max_iter: int = 100, ftol: float = 1e-10, max_step: 
         x, f, g = xt, ft, gt
         cl = cluster() if cluster is not None else None
         cl_fail = False
-        sy = float(s @ y)
-        if sy > 1e-14 * float(s @ s):
-            By = B @ y
-            rho = 1.0 / sy
-            B = B + ((sy + y @ By) * rho * rho) * (s[:, None] * s) - rho * (By[:, None] * s + s[:, None] * By)
+        B = _bfgs_update(B, s, y)
         small = small + 1 if drop < ftol else 0
         if small >= 2:
             stop = "ftol"
