@@ -378,6 +378,23 @@ def test_ill_conditioned_certificate_is_not_below_mu():
     assert dg_bound(M, S, up.Dl, up.Dr, up.G) >= exact
 
 
+@pytest.mark.parametrize("dl0, g", [(1e-300, 1e10), (1.0, 1e300)], ids=["D-1e-300", "G-1e300"])
+def test_certificate_of_scalings_beyond_the_double_range(dl0, g):
+    """Scalings whose congruent form overflows double precision (a D of 1e-300 beside 1 with a G of
+    1e10: the certificate used to be NaN) or spans 300 decades: the level is the one 400-digit
+    arithmetic gives, never below it (an eigensolver in 40 digits on the congruence returned 1.0
+    for 141421.356)."""
+    S = BlockStructure([Block.real(), Block.full(1)])
+    M = np.array([[1 + 1j, 2], [0.5, -1j]])
+    D = np.diag([dl0, 1.0]).astype(complex)
+    G = np.array([[g, 0], [0, 0]], complex)
+    exact = exact_dg_level(M, D, D, G, dps=400)
+    value = dg_bound(M, S, D, D, G)
+    assert np.isfinite(value)
+    assert value >= exact
+    assert value == pytest.approx(exact, rel=1e-12)
+
+
 def test_lower_bound_of_zero_matrix():
     S = BlockStructure([Block.scalar(), Block.real()])
     lo = mu_lower(np.zeros((2, 2)), S)

@@ -5,6 +5,7 @@ with it (a generalised eigenvalue of the D-G inequality, or a singular value).
 """
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 
 import numpy as np
@@ -93,67 +94,83 @@ _MARGIN_RTOL = 1e-10
 def _top_direction(M, Dl, Dr, G):
     """The top generalised eigenvector of ``(M^H Dl M + j(GM - M^H G^H), Dr)`` in double precision
     (any vector gives a lower bound through its Rayleigh quotient; this one nearly the best), or
-    None where it cannot be computed."""
+    None where it cannot be computed (scalings beyond the double range among them)."""
     try:
-        X = M.conj().T @ Dl @ M
-        if G is not None:
-            GM = G @ M
-            X = X + 1j * (GM - GM.conj().T)
-        ev, Q = np.linalg.eigh(0.5 * (Dr + Dr.conj().T))
-        if not ev[0] > 0:
-            return None
-        Ri = (Q / np.sqrt(ev)) @ Q.conj().T
-        Y = Ri @ X @ Ri
-        v = np.linalg.eigh(0.5 * (Y + Y.conj().T))[1][:, -1]
-        w = Ri @ v
+        with np.errstate(over="ignore", invalid="ignore"):
+            X = M.conj().T @ Dl @ M
+            if G is not None:
+                GM = G @ M
+                X = X + 1j * (GM - GM.conj().T)
+            ev, Q = np.linalg.eigh(0.5 * (Dr + Dr.conj().T))
+            if not ev[0] > 0:
+                return None
+            Ri = (Q / np.sqrt(ev)) @ Q.conj().T
+            Y = Ri @ X @ Ri
+            v = np.linalg.eigh(0.5 * (Y + Y.conj().T))[1][:, -1]
+            w = Ri @ v
     except (np.linalg.LinAlgError, ValueError, FloatingPointError):
         return None
     return w if np.all(np.isfinite(w)) else None
 
 
 def _gevp_mp(M, Dl, Dr, G, dps: int = 40) -> float:
-    r"""The generalised eigenvalue of :func:`_gevp` in ``dps``-digit arithmetic (mpmath), as a
-    double at or above it: the certificate of given double-precision scalings, whatever their
-    conditioning.  Used only where the rounding margin of the double-precision evaluation
-    matters.
+    r"""The generalised eigenvalue of :func:`_gevp` as a double at or above it, decided in
+    ``dps``-digit arithmetic (mpmath) by Cholesky factorisations: the certificate of given
+    double-precision scalings, whatever their conditioning.  Used only where the rounding
+    margin of the double-precision evaluation matters.
 
-    First the cheap route: the Rayleigh quotient :math:`\theta = w^HXw / w^HD_rw` of the
-    double-precision top eigenvector (a lower bound on the exact level squared), and a Cholesky
-    factorisation of :math:`\hat\beta^2D_r - X` at :math:`\hat\beta = \sqrt\theta\,(1 +
-    10^{-13})` (its success proves :math:`\hat\beta` a bound, 1e-13 from the exact level);
-    where it fails, the eigenvalues in ``dps`` digits (about 4x the time)."""
+    :math:`\beta` bounds the level exactly when :math:`\beta^2D_r - X \succ 0`
+    (:math:`X = M^HD_\ell M + j(GM - M^HG^H)`), which a Cholesky factorisation decides without
+    forming :math:`D_r^{-1/2}` (an eigensolver in 40 digits on that congruence loses the level
+    where the scalings span more than 40 decades).  First the Rayleigh quotient
+    :math:`\theta = w^HXw / w^HD_rw` of the double-precision top eigenvector (a lower bound) and one
+    factorisation 1e-13 above it; where that fails, bisection between the two by factorisations
+    to 1e-15 (about 50 of them)."""
     import mpmath as mp
+
+    def proves(beta) -> bool:
+        Z = mp.mpf(beta) ** 2 * R - X
+        try:
+            mp.cholesky(0.5 * (Z + Z.H))
+            return True
+        except (ValueError, ZeroDivisionError):
+            return False
+
     w = _top_direction(M, Dl, Dr, G)
     with mp.workdps(dps):
-        Mm, L, R = (mp.matrix(np.asarray(X, complex).tolist()) for X in (M, Dl, Dr))
+        Mm, L, R = (mp.matrix(np.asarray(Y, complex).tolist()) for Y in (M, Dl, Dr))
         X = Mm.H * L * Mm
         if G is not None:
-            Gm = mp.matrix(np.asarray(G, complex).tolist())
-            GM = Gm * Mm
+            GM = mp.matrix(np.asarray(G, complex).tolist()) * Mm
             X = X + 1j * (GM - GM.H)
         X = 0.5 * (X + X.H)
         R = 0.5 * (R + R.H)
+        lo = 0.0
         if w is not None:
             wm = mp.matrix(w.tolist())
             num, den = mp.re((wm.H * X * wm)[0]), mp.re((wm.H * R * wm)[0])
             if den > 0 and num > 0:
-                theta = num / den
-                cand = float(np.nextafter(float(mp.sqrt(theta)) * (1.0 + 1e-13), np.inf))
-                Z = mp.mpf(cand) ** 2 * R - X
-                try:
-                    mp.cholesky(0.5 * (Z + Z.H))
+                lo = float(mp.sqrt(num / den))
+                cand = float(np.nextafter(lo * (1.0 + 1e-13), np.inf))
+                if proves(cand):
                     return cand
-                except (ValueError, ZeroDivisionError):
-                    pass            # not positive definite at cand: the eigenvalues decide
-        E, Q = mp.eigh(R)
-        if min(mp.re(e) for e in E) <= 0:
-            return np.inf
-        Rih = Q * mp.diag([1 / mp.sqrt(mp.re(e)) for e in E]) * Q.H
-        Y = Rih * X * Rih
-        lam = max(mp.re(e) for e in mp.eigh(0.5 * (Y + Y.H), eigvals_only=True))
-        if lam <= 0:
-            return 0.0       # the exact inequality holds at beta = 0
-        return float(np.nextafter(float(mp.sqrt(lam)), np.inf))
+                lo = lo * (1.0 - 1e-15)     # the quotient rounded to a double: still below the level
+        if lo == 0.0 and proves(0.0):
+            return 0.0                      # the exact inequality holds at beta = 0
+        hi = max(2.0 * lo, 1e-300)
+        while not proves(hi):
+            lo, hi = hi, hi * 1e3
+            if not math.isfinite(hi):
+                return np.inf
+        for _ in range(400):
+            if lo > 0 and hi <= lo * (1.0 + 1e-15):
+                break
+            mid = math.sqrt(lo * hi) if lo > 0 else hi * 1e-3
+            if proves(mid):
+                hi = mid
+            else:
+                lo = mid
+        return float(hi)
 
 
 def _gevp_fast(M, Dl, Dr, G, S: BlockStructure) -> tuple[float, float]:
@@ -162,25 +179,31 @@ def _gevp_fast(M, Dl, Dr, G, S: BlockStructure) -> tuple[float, float]:
     D_r^{-1/2}GD_\ell^{-1/2}` (a congruence by :math:`D_r^{-1/2}`, square roots taken block by
     block): ``(beta, rel)`` with ``beta`` its square root (what an optimiser compares
     levels by) and ``rel`` the bound of :func:`_rounding_margin` on the error of
-    ``beta ** 2`` relative to it; ``(inf, 0)`` when a scaling is not positive definite."""
+    ``beta ** 2`` relative to it; ``(inf, 0)`` when a scaling is not positive definite,
+    ``(nan, inf)`` when the form overflows double precision."""
     Lh = _block_power(Dl, S.col_slices, 0.5)
     Ri = _block_power(Dr, S.row_slices, -0.5)
     if Lh is None or Ri is None:
         return np.inf, 0.0
-    A = Lh @ M @ Ri
-    c = _pow2_scale(A)           # the value is homogeneous in (M, G): computed for (c M, c G)
-    if c != 1.0:
-        A = c * A
-    H = A.conj().T @ A
-    Gt = None
-    if G is not None:
-        Lhi = _block_power(Dl, S.col_slices, -0.5)
-        Gt = c * (Ri @ G @ Lhi)
-        GA = Gt @ A
-        H = H + 1j * (GA - GA.conj().T)
-    H = 0.5 * (H + H.conj().T)
-    lam = max(float(np.linalg.eigvalsh(H).max()), 0.0)
-    return float(np.sqrt(lam)) / c, _relative_margin(lam, _rounding_margin(A, Gt))
+    with np.errstate(over="ignore", invalid="ignore"):
+        A = Lh @ M @ Ri
+        c = _pow2_scale(A)           # the value is homogeneous in (M, G): computed for (c M, c G)
+        if c != 1.0:
+            A = c * A
+        H = A.conj().T @ A
+        Gt = None
+        if G is not None:
+            Lhi = _block_power(Dl, S.col_slices, -0.5)
+            Gt = c * (Ri @ G @ Lhi)
+            GA = Gt @ A
+            H = H + 1j * (GA - GA.conj().T)
+        H = 0.5 * (H + H.conj().T)
+        if not np.all(np.isfinite(H)):
+            # scalings spanning more than the double range (a D of 1e-300 with a G of 1e10):
+            # only the extended-precision evaluation can say
+            return np.nan, np.inf
+        lam = max(float(np.linalg.eigvalsh(H).max()), 0.0)
+        return float(np.sqrt(lam)) / c, _relative_margin(lam, _rounding_margin(A, Gt))
 
 
 def _relative_margin(lam: float, margin: float) -> float:
@@ -194,8 +217,8 @@ def _gevp_certified(M, Dl, Dr, G, beta: float, rel: float) -> float:
     """The bound from a double-precision evaluation ``(beta, rel)`` of :func:`_gevp_fast`:
     ``beta`` with the margin added where it is negligible, the extended-precision value
     where it is not."""
-    if not np.isfinite(beta):
-        return beta
+    if beta == np.inf:
+        return beta                 # a scaling not positive definite
     if rel <= _MARGIN_RTOL:
         return float(beta * np.sqrt(1.0 + rel))
     return _gevp_mp(M, Dl, Dr, G)

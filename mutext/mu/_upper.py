@@ -47,17 +47,20 @@ def _gevp_diagonal(M, Dl, Dr, G):
     dl, dr = dl.real, dr.real
     if not (dl.min() > 0 and dr.min() > 0):
         return np.inf
-    lh, ri = np.sqrt(dl), 1.0 / np.sqrt(dr)
-    A = (lh[:, None] * M) * ri
-    c = _pow2_scale(A)           # as in _gevp: exact rescaling of entries that would underflow when squared
-    if c != 1.0:
-        A = c * A
-    H = A.conj().T @ A
-    Gt = None
-    if G is not None:
-        Gt = (ri[:, None] * (c * G)) / lh
-        GA = Gt @ A
-        H = H + 1j * (GA - GA.conj().T)
+    with np.errstate(over="ignore", invalid="ignore"):
+        lh, ri = np.sqrt(dl), 1.0 / np.sqrt(dr)
+        A = (lh[:, None] * M) * ri
+        c = _pow2_scale(A)           # as in _gevp: exact rescaling of entries that would underflow when squared
+        if c != 1.0:
+            A = c * A
+        H = A.conj().T @ A
+        Gt = None
+        if G is not None:
+            Gt = (ri[:, None] * (c * G)) / lh
+            GA = Gt @ A
+            H = H + 1j * (GA - GA.conj().T)
+    if not np.all(np.isfinite(H)):
+        return None                 # beyond the double range: _gevp decides
     w, _, info = _zheevd(H, compute_v=0)       # one triangle: H is Hermitian up to rounding
     lam = w[-1] if info == 0 else np.linalg.eigvalsh(0.5 * (H + H.conj().T))[-1]
     lam = max(float(lam), 0.0)
