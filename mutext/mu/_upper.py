@@ -207,7 +207,8 @@ def mu_upper(M, structure: BlockStructure, *, method: str = "auto", real: str = 
             # the bound its scalings prove: where the descent drives the scalings nearly singular
             # with a large G, its double-precision value can sit below that (and below the optimal
             # D-G bound: 7.5e-6 on a repeated real scalar)
-            up.value = float(_gevp(M, up.Dl, up.Dr, up.G, S))
+            cert = _gevp_diagonal(M, up.Dl, up.Dr, up.G)     # diagonal scalings: no block roots
+            up.value = float(_gevp(M, up.Dl, up.Dr, up.G, S) if cert is None else cert)
         return up
     if method == "auto":
         return _upper_auto(M, S, use_g, lower, rtol, nrm)
