@@ -378,6 +378,62 @@ def test_ill_conditioned_certificate_is_not_below_mu():
     assert dg_bound(M, S, up.Dl, up.Dr, up.G) >= exact
 
 
+def _graded_scalings(rng, n):
+    """Diagonal scalings over 17 decades with G up to 1e10 times them on 1 x 1 real blocks."""
+    d = np.exp(rng.uniform(-20, 20, n))
+    G = np.diag([rng.standard_normal() * 10 ** rng.uniform(-2, 10) * dk if rng.random() < 0.7 else 0.0
+                 for dk in d]).astype(complex)
+    return np.diag(d).astype(complex), G
+
+
+#: a complex and a real scalar where the optimal D-G bound is approached as G -> infinity
+#: (bench_mu.py cases 62 and 102): the descent ends with G near 2e9 and D near 4e9
+_G_TO_INFINITY = [
+    [[-0.9176873314122128 - 1.1930267990538967j, -0.2914057545045271 - 0.20972032240767963j],
+     [-0.24648101289523083 - 1.0546794613866448j, -2.059272771521102 - 0.37215759769670537j]],
+    [[-0.5936751273756264 - 1.942232859371308j, 0.8612190556690689 + 2.1129201593831803j],
+     [-0.04393442340863364 + 1.8849826072080755j, 1.1924864710821501 - 1.4481993417672274j]],
+]
+
+
+@pytest.mark.parametrize("M", _G_TO_INFINITY, ids=["case62", "case102"])
+def test_graded_certificate_is_proved_in_double_precision(monkeypatch, M):
+    """Scalings whose congruent form is graded (entries of 1e9 beside an eigenvalue of 2): the
+    norm-based rounding margin was 14 % of the level, which sent the certificate to 40-digit
+    arithmetic (1 ms of a 2.7 ms call). A Cholesky factorisation of the equilibrated form
+    with every rounding bounded proves a level 5e-14 above the exact one, in double precision."""
+    from mutext.mu import _certificate as cert
+
+    def no_mp(*a, **k):
+        raise AssertionError("extended precision used")
+    monkeypatch.setattr(cert, "_gevp_mp", no_mp)
+    S = BlockStructure([Block.scalar(), Block.real()])
+    M = np.array(M)
+    up = mu_upper(M, S)
+    assert abs(up.G).max() > 1e8                   # the graded case this test is about
+    exact = exact_dg_level(M, up.Dl, up.Dr, up.G)
+    assert exact <= up.value <= exact * (1 + 1e-12)
+    assert exact <= dg_bound(M, S, up.Dl, up.Dr, up.G) <= exact * (1 + 1e-12)
+    # the lower bound: the certificate is not below mu
+    assert up.value >= mu_lower(M, S).value
+
+
+def test_cholesky_proof_never_proves_a_level_below_the_certificate():
+    """The double-precision proof (a factorisation of the equilibrated form with every rounding
+    bounded) asked for a level 2e-10 or 1e-9 below the exact one must fail: its largest step is
+    1e-10 (checked against 60-digit arithmetic on graded scalings)."""
+    from mutext.mu._certificate import _gevp_cholesky
+    rng = np.random.default_rng(11)
+    for k in range(60):
+        n = int(rng.integers(1, 5))
+        M = crandn(rng, n, n)
+        Dl, G = _graded_scalings(rng, n)
+        exact = exact_dg_level(M, Dl, Dl, G, dps=60)
+        for f in (1 - 2e-10, 1 - 1e-9):
+            got = _gevp_cholesky(M, Dl, Dl, G, exact * f)
+            assert got is None or got >= exact, (k, f, got, exact)
+
+
 @pytest.mark.parametrize("dl0, g", [(1e-300, 1e10), (1.0, 1e300)], ids=["D-1e-300", "G-1e300"])
 def test_certificate_of_scalings_beyond_the_double_range(dl0, g):
     """Scalings whose congruent form overflows double precision (a D of 1e-300 beside 1 with a G of

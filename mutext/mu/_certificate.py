@@ -76,14 +76,17 @@ def _rounding_margin(A, Gt) -> float:
     the products errs by at most :math:`n\varepsilon|A|^H|A|` and
     :math:`n\varepsilon|\tilde G||A|` entrywise, and a backward-stable eigensolver adds
     :math:`p(n)\varepsilon\|H\|` (Weyl), both below :math:`4n\varepsilon(\|A\|_F^2 +
-    2\|\tilde G\|_F\|A\|_F)`.  A few :math:`\varepsilon` of the value where the scalings are
+    2\||\tilde G||A|\|_F)`.  A few :math:`\varepsilon` of the value where the scalings are
     well conditioned; where a solver's scalings are nearly singular and its :math:`G` large,
     terms of 1e12 cancel to an eigenvalue of 1 and the double-precision value can sit below a
-    true lower bound on :math:`\mu` (seen: by 1.1e-8 relative)."""
+    true lower bound on :math:`\mu` (seen: by 1.1e-8 relative).  The product of the
+    absolute values, not of the norms: a large :math:`\tilde G` meets only the rows of
+    :math:`A` of its real block, which the scalings often make small (:math:`\|\tilde G\|_F
+    \|A\|_F` overstated the error 1e12-fold on a real block whose G approached infinity)."""
     n = A.shape[0] + A.shape[1]
     a = float(np.linalg.norm(A))
-    g = 0.0 if Gt is None else float(np.linalg.norm(Gt))
-    return 4.0 * n * np.finfo(float).eps * (a * a + 2.0 * g * a)
+    ga = 0.0 if Gt is None else float(np.linalg.norm(np.abs(Gt) @ np.abs(A)))
+    return 4.0 * n * np.finfo(float).eps * (a * a + 2.0 * ga)
 
 
 # relative rounding margin (of beta**2) above which the certificate is recomputed in extended
@@ -173,6 +176,80 @@ def _gevp_mp(M, Dl, Dr, G, dps: int = 40) -> float:
         return float(hi)
 
 
+#: relative steps above the double-precision level at which :func:`_gevp_cholesky` tries to prove
+#: the bound (the last as large as the margin :func:`_gevp_certified` adds without a proof)
+_CHOLESKY_STEPS = (1e-13, 1e-11, 1e-10)
+
+
+def _gevp_cholesky(M, Dl, Dr, G, beta: float) -> float | None:
+    r"""A bound just above the double-precision level ``beta``, proved by a Cholesky factorisation
+    in double precision with all rounding accounted for; None where no step of
+    ``_CHOLESKY_STEPS`` can be proved that way (then only extended precision can decide).
+
+    :math:`\sqrt b` bounds the level when :math:`Z = bD_r - X \succ 0`
+    (:math:`X = M^HD_\ell M + j(GM - M^HG^H)`).  Definiteness is invariant under the diagonal
+    congruence :math:`Y = SZS`, :math:`S = \mathrm{diag}(z_{ii}^{-1/2})`, which gives ``Y`` a unit
+    diagonal: the scale-free form of the question, where a graded ``Z`` (entries of 1e9 beside
+    entries of 1 when ``G`` approaches infinity on a real block) is as easy to decide as a
+    well-scaled one, while a bound through :math:`\|Z\|` is not.  With
+    :math:`|\Delta Z| \le E = 4(2n+6)arepsilon(|M|^H|D_\ell||M| + 2|G||M| + b|D_r|)` entrywise
+    (forming ``Z`` in complex arithmetic: N. J. Higham, *Accuracy and Stability of Numerical
+    Algorithms*, 2002, sec. 3.5), the rounding of the scaling
+    (:math:`3arepsilon|Y|`) and, for a floating-point Cholesky factorisation that runs to
+    completion on a symmetric ``A`` of order ``m``, :math:`\lambda_{\min}(A) \ge
+    -rac{\gamma_{m+1}}{1-\gamma_{m+1}}\operatorname{tr}A` (from Demmel's
+    :math:`\hat R^T\hat R = A + \Delta A`, :math:`|\Delta A| \le \gamma_{m+1}|\hat R^T||\hat R|`;
+    S. M. Rump, "Verification of positive definiteness", *BIT* 46, 2006), a factorisation of the real form of :math:`Y - cI` (order ``2n``) with
+    :math:`c = 2(lpha\operatorname{tr}Y + arepsilon\max_i y_{ii}) + 4arepsilon\|Y\|_F +
+    \|SES\|_F`, doubled, proves :math:`Z \succ 0`: the exact inequality, not its rounded form.
+    """
+    from scipy.linalg.lapack import dpotrf
+
+    eps = np.finfo(float).eps
+    n = Dr.shape[0]
+    with np.errstate(over="ignore", invalid="ignore", under="ignore"):
+        aM = np.abs(M)
+        X = M.conj().T @ (Dl @ M)
+        E0 = aM.T @ (np.abs(Dl) @ aM)
+        if G is not None:
+            GM = G @ M
+            X = X + 1j * (GM - GM.conj().T)
+            E0 = E0 + 2.0 * (np.abs(G) @ aM)
+        aDr = np.abs(Dr)
+        if not (np.all(np.isfinite(X)) and np.all(np.isfinite(E0))):
+            return None
+        m = 2 * n
+        gam = (m + 1) * eps / (1.0 - (m + 1) * eps)
+        alpha = gam / (1.0 - gam)
+        kE = 4.0 * (2 * n + 6) * eps
+        low = np.tril_indices(n, -1)
+        for step in _CHOLESKY_STEPS:
+            b = beta * beta * (1.0 + step)
+            Z = b * Dr - X
+            # Hermitian from one triangle (the error bound E holds entrywise for either)
+            Z[(low[1], low[0])] = Z[low].conj()
+            dz = Z.diagonal().real.copy()
+            Z[np.diag_indices(n)] = dz
+            if not dz.min() > 0 or not np.isfinite(b):
+                return None
+            s = 1.0 / np.sqrt(dz)
+            Y = (s[:, None] * Z) * s
+            Es = (s[:, None] * (kE * (E0 + b * aDr))) * s
+            c = 2.0 * (2.0 * alpha * float(Y.diagonal().real.sum()) + 2.0 * eps
+                       + 4.0 * eps * float(np.linalg.norm(Y)) + float(np.linalg.norm(Es))) + 1e-290
+            if not c < 0.5:
+                continue            # too little room: a larger step, or extended precision
+            Yr = np.empty((m, m))
+            Yr[:n, :n] = Yr[n:, n:] = Y.real
+            Yr[:n, n:] = -Y.imag
+            Yr[n:, :n] = Y.imag
+            Yr[np.diag_indices(m)] -= c
+            _, info = dpotrf(Yr, lower=1, clean=0)
+            if info == 0:
+                return float(np.nextafter(math.sqrt(b), np.inf))
+    return None
+
+
 def _gevp_fast(M, Dl, Dr, G, S: BlockStructure) -> tuple[float, float]:
     r"""The largest eigenvalue of :math:`A^HA + j(\tilde G A - A^H\tilde G^H)` in double
     precision, with :math:`A = D_\ell^{1/2}MD_r^{-1/2}` and :math:`\tilde G =
@@ -221,6 +298,10 @@ def _gevp_certified(M, Dl, Dr, G, beta: float, rel: float) -> float:
         return beta                 # a scaling not positive definite
     if rel <= _MARGIN_RTOL:
         return float(beta * np.sqrt(1.0 + rel))
+    if math.isfinite(beta) and beta > 0:
+        proved = _gevp_cholesky(M, Dl, Dr, G, beta)
+        if proved is not None:
+            return proved
     return _gevp_mp(M, Dl, Dr, G)
 
 
