@@ -387,7 +387,7 @@ def _graded_scalings(rng, n):
 
 
 #: a complex and a real scalar where the optimal D-G bound is approached as G -> infinity
-#: (bench_mu.py cases 62 and 102): the descent ends with G near 2e9 and D near 4e9
+#: (bench_mu.py cases 62 and 102): the descent ends with G of 5e7 to 2e9
 _G_TO_INFINITY = [
     [[-0.9176873314122128 - 1.1930267990538967j, -0.2914057545045271 - 0.20972032240767963j],
      [-0.24648101289523083 - 1.0546794613866448j, -2.059272771521102 - 0.37215759769670537j]],
@@ -410,7 +410,7 @@ def test_graded_certificate_is_proved_in_double_precision(monkeypatch, M):
     S = BlockStructure([Block.scalar(), Block.real()])
     M = np.array(M)
     up = mu_upper(M, S)
-    assert abs(up.G).max() > 1e8                   # the graded case this test is about
+    assert abs(up.G).max() > 1e7                   # the graded case this test is about
     exact = exact_dg_level(M, up.Dl, up.Dr, up.G)
     assert exact <= up.value <= exact * (1 + 1e-12)
     assert exact <= dg_bound(M, S, up.Dl, up.Dr, up.G) <= exact * (1 + 1e-12)

@@ -64,6 +64,29 @@ def test_stationary_point_at_a_kink_ends_the_descent():
     assert up.iterations < 100
 
 
+def test_descent_in_rounding_noise_ends():
+    """Two real scalars and a complex one (bench_mu case 1349) where the optimum is approached as
+    G -> infinity on a real block: the form becomes graded, its top eigenvalue carries rounding
+    noise of 1e-8, and the descent wandered in that noise (66 evaluations), then restarted from
+    G-hat clipped for a warm start from another matrix (49 more, a value 3e7 times too large
+    first). Now a gain below ten times the noise is no gain, and a restart at the same matrix
+    starts where the descent ended."""
+    ab13md = pytest.importorskip("slycot").ab13md
+    S = BlockStructure([Block.real(), Block.real(), Block.scalar()])
+    M = np.array([[-0.030440993352111697 - 1.7726925971644445j, 0.9356486141934136 + 1.159370958088475j,
+                   -0.4827980337149612 - 0.5573003314917988j],
+                  [0.4515175142251865 - 0.7750932108003858j, 1.2788213450345631 - 0.03231360707627265j,
+                   0.7170736224523957 + 0.2537222257006987j],
+                  [-0.1457647442019078 - 0.3806791385193098j, -0.6760945457878897 + 1.1474152298104359j,
+                   0.005316906488443538 + 0.1884739414553573j]])
+    up = mu_upper(M, S)
+    _certified(M, S, up)
+    assert abs(up.G[0, 0]) > 1e4 * up.Dr[0, 0].real            # G-hat far out: the graded case
+    ref = ab13md(M, np.array([1, 1, 1]), np.array([1, 1, 2]))[0]
+    assert up.value <= ref * (1 + 1e-6)
+    assert up.iterations <= 60
+
+
 def test_fast_bound_is_the_one_its_scalings_prove():
     """A repeated real scalar where the fast descent drives its scalings nearly singular (a
     factor of e^-12) with G near 1e7: its value in double precision was 7.5e-6 below the optimal

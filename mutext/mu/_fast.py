@@ -17,6 +17,9 @@ from ._osborne import _osborne
 from ._structure import BlockStructure, _norm2
 
 
+_EPS_N = float(np.finfo(float).eps)
+
+
 class _DGParams:
     r"""Coordinates of the scalings of the fast D-G bound for one structure.
 
@@ -67,6 +70,8 @@ class _DGParams:
             self.El = np.eye(self.m)[S.col_block]
             self.Er = np.eye(self.m)[S.row_block]
 
+    #: relative rounding noise of the last value (see value_grad)
+    noise = 0.0
     #: set by the caller: value_grad then also keeps what the first-order model of the top two
     #: eigenvalues (diagonal scalings only, :meth:`model`) is built from in ``cluster``
     want_cluster = False
@@ -175,6 +180,9 @@ class _DGParams:
             if info != 0:
                 raise np.linalg.LinAlgError("eigenvalues of the scaled form did not converge")
             lam, v = float(w[-1]), V[:, -1]
+            # rounding noise of log lambda here: eps times the size of H (its extreme eigenvalues)
+            # over lambda; a G-hat approaching infinity makes H graded and this large
+            self.noise = _EPS_N * H.shape[0] * max(-float(w[0]), lam) / lam if lam > 0 else np.inf
             if not grad:
                 return lam, None
             if self.want_cluster:
@@ -284,6 +292,8 @@ _CLUSTER_MODE = "stall"
 #: the descent also stops when a step gained less than ftol and the next BFGS step is predicted
 #: (-g'p, twice the quadratic model's decrease) to gain less than _PRED_STOP * ftol
 _PRED_STOP = 1.0
+#: a step gaining less than this multiple of the rounding noise of the bound counts as no gain
+_NOISE_FACTOR = 10.0
 
 
 def _cluster_step(cl, B):
@@ -358,7 +368,7 @@ def _bfgs_update(B, s, y):
 
 
 def _bfgs(fun, x0, B0=None, max_iter: int = 100, ftol: float = 1e-10, max_step: float = 1.0,
-          max_eval: int = 400, info: dict | None = None, cluster=None):
+          max_eval: int = 400, info: dict | None = None, cluster=None, noise=None):
     r"""Minimise a (possibly nonsmooth at optimum) function by BFGS with a weak Wolfe line search.
 
     The line search of Lewis and Overton [LO]_ (bisection/doubling on the
@@ -373,10 +383,13 @@ def _bfgs(fun, x0, B0=None, max_iter: int = 100, ftol: float = 1e-10, max_step: 
     ``cluster`` (optional) returns the model of the two largest eigenvalues at the point
     last evaluated (see :func:`_cluster_step`); where their gap is below ``_CLUSTER_GAP``
     the step is taken on that model (Armijo backtracking on its predicted decrease), with
-    the gradient step as fallback.
+    the gradient step as fallback.  ``noise`` (optional) returns the rounding noise of ``f`` at
+    the point last evaluated: a step gaining less than ``_NOISE_FACTOR`` times it counts as
+    gaining less than ``ftol`` (a descent in rounding noise only wanders).
     """
     x = x0.copy()
     f, g = fun(x)
+    tol = max(ftol, _NOISE_FACTOR * noise()) if noise is not None else ftol
     cl = cluster() if cluster is not None else None
     nev = 1
     n = x.size
@@ -419,16 +432,18 @@ def _bfgs(fun, x0, B0=None, max_iter: int = 100, ftol: float = 1e-10, max_step: 
                     drop = f - ft
                     moved = True
                     x, f, g = xt, ft, gt
+                    if noise is not None:
+                        tol = max(ftol, _NOISE_FACTOR * noise())
                     cl = cluster()
                     B = _bfgs_update(B, s_, y_)
-                    small = small + 1 if drop < ftol else 0
+                    small = small + 1 if drop < tol else 0
                     if small >= 2:
                         stop = "ftol"
                         break
                     continue
         p = -B @ g
         gp = float(g @ p)
-        if small and -gp < _PRED_STOP * ftol:
+        if small and -gp < _PRED_STOP * tol:
             stop = "ftol"           # the last step gained < ftol and the next is predicted to gain less
             break
         if not gp < 0:
@@ -478,10 +493,12 @@ def _bfgs(fun, x0, B0=None, max_iter: int = 100, ftol: float = 1e-10, max_step: 
         drop = f - ft
         moved = True
         x, f, g = xt, ft, gt
+        if noise is not None:
+            tol = max(ftol, _NOISE_FACTOR * noise())
         cl = cluster() if cluster is not None else None
         cl_fail = False
         B = _bfgs_update(B, s, y)
-        small = small + 1 if drop < ftol else 0
+        small = small + 1 if drop < tol else 0
         if small >= 2:
             stop = "ftol"
             break
@@ -499,16 +516,21 @@ _G_CLIP = 8.0
 
 def _upper_fast(M, S: BlockStructure, params: _DGParams, x0=None, B0=None, ftol: float = 1e-10,
                 max_eval: int = 400, info: dict | None = None, osborne_tol: float = 0.0,
-                kinks: bool = False):
+                kinks: bool = False, beta0: float | None = None):
     """Fast D (or D-G) bound at one matrix, from coordinates ``x0`` (None: Osborne balancing).
 
     Returns (MuUpper, x, inverse Hessian) with the value recomputed from the
     scalings' coordinates (the exact largest eigenvalue of the congruent form).
     With ``kinks`` (diagonal scalings only) the descent steps on the model of the two
     largest eigenvalues where they nearly coincide (:func:`_cluster_step`).
+    ``beta0``: the G-hat scale of an earlier descent at the same matrix (``info["beta0"]``
+    of it) when ``x0`` is its end point: the restart then starts at exactly that point
+    (no clipping of G-hat, which is for warm starts from another matrix).
     """
     if x0 is None:
         x0 = params.initial(np.exp(_osborne(M, S, tol=osborne_tol)))
+    elif beta0 is not None:
+        x0 = x0.copy()
     else:
         # a warm start: G-hat near a previous frequency's, but not the large values
         # of a frequency where the infimum is approached as G -> infinity (a flat
@@ -517,12 +539,14 @@ def _upper_fast(M, S: BlockStructure, params: _DGParams, x0=None, B0=None, ftol:
         for gs in params.gslots:
             if gs is not None:
                 x0[gs] = np.clip(x0[gs], -_G_CLIP, _G_CLIP)
-    if params.use_g:
+    if not params.use_g:
+        beta0 = 1.0         # no G: beta0 does not enter
+    elif beta0 is None:
         beta0 = np.sqrt(max(params.value_grad(x0, M, 1.0, grad=False)[0], 0.0))
         if beta0 == 0:
             beta0 = 1.0
-    else:
-        beta0 = 1.0         # no G: beta0 does not enter
+    if info is not None:
+        info["beta0"] = beta0
     # the first G-free sigma_max: with a warm start G carries over (it is scaled by beta0)
     free = params.free
 
@@ -548,7 +572,8 @@ def _upper_fast(M, S: BlockStructure, params: _DGParams, x0=None, B0=None, ftol:
     params.want_cluster, params.cluster = cluster is not None, None
     try:
         with np.errstate(over="ignore", invalid="ignore"):
-            f, y, B, nev = _bfgs(fun, x0[free], B0, ftol=ftol, max_eval=max_eval, info=info, cluster=cluster)
+            f, y, B, nev = _bfgs(fun, x0[free], B0, ftol=ftol, max_eval=max_eval, info=info, cluster=cluster,
+                                 noise=(lambda: params.noise) if params.diag else None)
     finally:
         params.want_cluster, params.cluster = False, None
     x = x0.copy()
@@ -565,7 +590,7 @@ def _upper_fast(M, S: BlockStructure, params: _DGParams, x0=None, B0=None, ftol:
 
 def _fast_at(M, S: BlockStructure, params: _DGParams, x0=None, B0=None, ftol: float = 1e-10,
              max_eval: int = 400, info: dict | None = None, osborne_tol: float = 0.0,
-             kinks: bool = False, nrm: float | None = None):
+             kinks: bool = False, nrm: float | None = None, beta0: float | None = None):
     """:func:`_upper_fast` with the shortcuts of :func:`mu_upper` (one full block, ``M = 0``,
     extreme norms); returns (MuUpper, coordinates or None, inverse Hessian or None).
     ``nrm``: sigma_max(M) if already known."""
@@ -574,21 +599,23 @@ def _fast_at(M, S: BlockStructure, params: _DGParams, x0=None, B0=None, ftol: fl
     if nrm == 0 or (len(S) == 1 and S.blocks[0].kind == "full"):
         return _diag_result(M, S, np.ones(len(S)), "sigma"), None, None
     if not 1e-100 <= nrm <= 1e100:
-        up, x, B = _upper_fast(M / nrm, S, params, x0, B0, ftol, max_eval, info, osborne_tol, kinks)
+        up, x, B = _upper_fast(M / nrm, S, params, x0, B0, ftol, max_eval, info, osborne_tol, kinks, beta0)
         return MuUpper(float(up.value * nrm), up.method, d=up.d, Dl=up.Dl, Dr=up.Dr,
                        G=None if up.G is None else up.G * nrm, iterations=up.iterations), x, B
-    return _upper_fast(M, S, params, x0, B0, ftol, max_eval, info, osborne_tol, kinks)
+    return _upper_fast(M, S, params, x0, B0, ftol, max_eval, info, osborne_tol, kinks, beta0)
 
 
 def _fast_polish(M, S: BlockStructure, params: _DGParams, x0=None):
     """The fast bound to full accuracy: long descents, restarted from the point reached
     (BFGS can stall at a kink of lambda_max, e.g. with repeated real scalars, and a
     fresh Hessian approximation often continues).  Returns (MuUpper, coordinates)."""
-    up, x, _ = _fast_at(M, S, params, x0, None, ftol=1e-12, max_eval=400)
+    info = {}
+    up, x, _ = _fast_at(M, S, params, x0, None, ftol=1e-12, max_eval=400, info=info)
     for _ in range(_FAST_RESTARTS):
         if x is None:
             break
-        up2, x2, _ = _fast_at(M, S, params, x, None, ftol=1e-12, max_eval=400)
+        up2, x2, _ = _fast_at(M, S, params, x, None, ftol=1e-12, max_eval=400, info=info,
+                              beta0=info.get("beta0"))
         if not up2.value < up.value * (1 - 1e-10):
             break
         up, x = up2, x2
@@ -621,7 +648,7 @@ def _fast_default(M, S: BlockStructure, params: _DGParams, always: bool = False,
             # would repeat the same failed line search
             break
         up2, x2, _ = _fast_at(M, S, params, x, None, ftol=_AUTO_FTOL, max_eval=_RESTART_EVALS, info=info, kinks=True,
-                              nrm=nrm)
+                              nrm=nrm, beta0=info.get("beta0"))
         nev += up2.iterations
         if not up2.value < up.value * (1 - 1e-10):
             break
