@@ -482,7 +482,9 @@ def _bfgs(fun, x0, B0=None, max_iter: int = 100, ftol: float = 1e-10, max_step: 
     """
     x = x0.copy()
     f, g = fun(x)
-    tol = max(ftol, _NOISE_FACTOR * noise()) if noise is not None else ftol
+    def tol_here():
+        return max(ftol, _NOISE_FACTOR * noise()) if noise is not None else ftol
+    tol = tol_here()
     cl = cluster() if cluster is not None else None
     nev = 1
     n = x.size
@@ -525,8 +527,7 @@ def _bfgs(fun, x0, B0=None, max_iter: int = 100, ftol: float = 1e-10, max_step: 
                     drop = f - ft
                     moved = True
                     x, f, g = xt, ft, gt
-                    if noise is not None:
-                        tol = max(ftol, _NOISE_FACTOR * noise())
+                    tol = tol_here()
                     cl = cluster()
                     B = _bfgs_update(B, s_, y_)
                     small = small + 1 if drop < tol else 0
@@ -586,8 +587,7 @@ def _bfgs(fun, x0, B0=None, max_iter: int = 100, ftol: float = 1e-10, max_step: 
         drop = f - ft
         moved = True
         x, f, g = xt, ft, gt
-        if noise is not None:
-            tol = max(ftol, _NOISE_FACTOR * noise())
+        tol = tol_here()
         cl = cluster() if cluster is not None else None
         cl_fail = False
         B = _bfgs_update(B, s, y)
