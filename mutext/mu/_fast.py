@@ -480,19 +480,17 @@ def _bfgs(fun, x0, B0=None, max_iter: int = 100, ftol: float = 1e-10, max_step: 
     the point last evaluated: a step gaining less than ``_NOISE_FACTOR`` times it counts as
     gaining less than ``ftol`` (a descent in rounding noise only wanders).
     """
-    x = x0.copy()
-    f, g = fun(x)
     def tol_here():
         return max(ftol, _NOISE_FACTOR * noise()) if noise is not None else ftol
+
+    x = x0.copy()
+    f, g = fun(x)
     tol = tol_here()
     cl = cluster() if cluster is not None else None
-    nev = 1
-    n = x.size
+    nev, n, small = 1, x.size, 0
     B = np.eye(n) if B0 is None else B0.copy()
     reset = B0 is None
-    small = 0
-    stop = "budget"
-    moved = False
+    stop, moved = "budget", False
     kinked = _CLUSTER_MODE == "always"
     cl_fail = False         # the model step failed at the current point
     for _ in range(max_iter):
