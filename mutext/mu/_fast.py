@@ -80,6 +80,41 @@ class _DGParams:
     want_cluster = False
     cluster = None
 
+    _stack_of = None
+
+    def _stack(self, M):
+        r"""The terms of the congruent form for diagonal scalings, for the matrix ``M``: with
+        :math:`d_k = e^{x_k}` and :math:`r = 1/d` over the rows,
+
+        .. math::
+            H = (rr^T)\circ\Bigl(\sum_k d_k^2 M_k^HM_k
+                + \sum_j g_j d_{k_j}^2\, j(E_jM - M^HE_j^T)\Bigr),
+
+        :math:`M_k` the rows of block ``k``, :math:`g_j = \beta_0\sinh y_j` the G-hat of real
+        block :math:`k_j` and :math:`E_j` its entry (the same products as :math:`A^HA +
+        j(\tilde GA - A^H\tilde G^H)`, :math:`A = D_\ell MD_r^{-1}`, entry by entry).  Built once
+        per matrix; ``value_grad`` is then one product with the stacked terms, one scaling and
+        one eigensolver call."""
+        m, r, n = self.m, self.nreal, self.S.nrows
+        St = np.empty((m + r, n, n), complex)
+        # sum over the rows of each block of the outer products conj(M_a)^T M_a
+        St[:m] = (self.El.T @ (M.conj()[:, :, None] * M[:, None, :]).reshape(M.shape[0], n * n)).reshape(m, n, n)
+        for j in range(r):
+            E = np.zeros((n, n), complex)
+            E[self.grow[j]] = M[self.gcol[j]]
+            St[m + j] = 1j * (E - E.conj().T)
+        self._stack_m, self._sflat, self._stack_of = St, St.reshape(m + r, n * n), M
+        if not hasattr(self, "_map2"):
+            mp = np.zeros((m + r, m))
+            mp[np.arange(m), np.arange(m)] = 2.0
+            mp[m + np.arange(r), self.real_idx] = 2.0
+            self._map2, self._er2 = mp, 2.0 * self.Er
+
+    def _scaled(self, M, x):
+        """A = D_l M D_r^-1 for diagonal scalings (the model of the top two eigenvalues)."""
+        e = np.exp(x[:self.m])
+        return (e[self.S.col_block][:, None] * M) * (1.0 / e)[self.S.row_block]
+
     def model(self, gap: float):
         """(lambda_2/lambda_1, C) at the point last evaluated, C a function returning the
         matrices of :meth:`_cluster` (built only when the descent steps on them) if the
@@ -95,11 +130,12 @@ class _DGParams:
             return r, None
         return r, lambda: self._cluster(*cl)[1]
 
-    def _cluster(self, A, w, V, beta0, gs, x):
+    def _cluster(self, M, w, V, beta0, gs, x):
         r"""First-order model of the two largest eigenvalues of H, divided by the largest:
         (w1/w0, C) with C[k] = Q^H (dH/dx_k) Q / w0 (2 x 2, all coordinates), Q the two top
         eigenvectors (largest first).  With ``A`` and ``Y = AQ - j G'^H Q``,
         :math:`Q^H\partial_kHQ = R_k^HY + Y^HR_k`, :math:`R_k = \partial_kA\,Q`."""
+        A = self._scaled(M, x)
         Q = V[:, :-3:-1]
         P = A @ Q
         Y = P.copy()
@@ -137,7 +173,8 @@ class _DGParams:
         :math:`Y^H(A\circ s_i\circ s_k)Q + R_i^HR_k` and its transpose; a G-hat coordinate
         ``y`` of entry (r, c) adds :math:`j\beta_0\cosh(y)\,e_r A_{c,:}` (second derivative
         :math:`\sinh` for ``cosh``; :math:`A\to\partial_kA` across)."""
-        A, w, V, beta0, gs, x = self.cluster
+        M, w, V, beta0, gs, x = self.cluster
+        A = self._scaled(M, x)
         m, N, n = self.m, self.size, A.shape[1]
         sel = self.sel
         Q = V[:, :-3:-1]
@@ -233,38 +270,41 @@ class _DGParams:
         r"""(lambda, grad log lambda) with :math:`\lambda = \lambda_{\max}(H)` (the squared bound)."""
         S = self.S
         if self.diag:
-            # one scaling per block (coordinates 0..m-1), G-hat on 1 x 1 real blocks after them;
-            # written with few numpy calls: this is the inner loop of the default bound
+            # one scaling per block (coordinates 0..m-1), G-hat on 1 x 1 real blocks after them,
+            # H = (r r^T) o sum_i c_i S_i (see _stack): the inner loop of the default bound, in
+            # few numpy calls
+            if self._stack_of is not M:
+                self._stack(M)
             m = self.m
-            e = np.exp(x[:m])
-            A = (e[S.col_block][:, None] * M) * (1.0 / e)[S.row_block]
-            H = A.conj().T @ A
+            e2 = np.exp(2.0 * x[:m])
+            ri = np.exp(-x[:m])[S.row_block]
             if self.nreal:
-                gs = np.sinh(x[m:])
-                # j(GA - (GA)^H), G mapping column gcol of A (z of the real block) to row grow
-                # (its w): GA has the rows grow only
-                T = 1j * ((beta0 * gs)[:, None] * A[self.gcol])
-                H[self.grow] += T
-                H[:, self.grow] += T.conj().T
+                gs = beta0 * np.sinh(x[m:])
+                coef = np.concatenate((e2, gs * e2[self.real_idx]))
+            else:
+                coef = e2
+            H = (coef @ self._sflat).reshape(S.nrows, S.nrows) * np.multiply.outer(ri, ri)
             w, V, info = _zheevd(H)
             if info != 0:
                 raise np.linalg.LinAlgError("eigenvalues of the scaled form did not converge")
             lam, v = float(w[-1]), V[:, -1]
             # rounding noise of log lambda here: eps times the size of H (its extreme eigenvalues)
             # over lambda; a G-hat approaching infinity makes H graded and this large
-            self.noise = _EPS_N * H.shape[0] * max(-float(w[0]), lam) / lam if lam > 0 else np.inf
+            self.noise = _EPS_N * S.nrows * max(-float(w[0]), lam) / lam if lam > 0 else np.inf
             if not grad:
                 return lam, None
             if self.want_cluster:
                 # kept for the model of the top two eigenvalues, built only where they are close
-                self.cluster = (A, w, V, beta0, gs if self.nreal else None, x)
-            a = A @ v
-            g = np.empty(self.size)
-            g[:m] = 2.0 * ((a.real ** 2 + a.imag ** 2) @ self.El - lam * ((v.real ** 2 + v.imag ** 2) @ self.Er))
+                self.cluster = (M, w, V, beta0, gs / beta0 if self.nreal else None, x)
+            # d/dx of u^H (sum c_i S_i) u with u = r o v: the coefficients' own (2 c_i q_i on
+            # their block) and -2 lambda |v|^2 over the block's rows from r
+            u = ri * v
+            q = ((self._stack_m @ u) @ u.conj()).real
+            gx = (coef * q) @ self._map2 - lam * ((v.real * v.real + v.imag * v.imag) @ self._er2)
             if self.nreal:
-                im = (np.conj(v[self.grow]) * a[self.gcol]).imag
-                g[self.real_idx] -= 4.0 * beta0 * gs * im
-                g[m:] = -2.0 * beta0 * im * np.cosh(x[m:])
+                g = np.concatenate((gx, (beta0 * np.cosh(x[m:])) * e2[self.real_idx] * q[m:]))
+            else:
+                g = gx
             return lam, g / max(lam, 1e-300)
         # general structure (repeated scalars): block-diagonal factors
         Lc = np.zeros((S.ncols, S.ncols), complex)
