@@ -60,6 +60,9 @@ def _block_power(D, slices, p: float):
     return out
 
 
+_EPS = float(np.finfo(float).eps)
+
+
 def _pow2_scale(A) -> float:
     """A power of two ``c`` with ``c * max|A|`` near 1 when ``max|A|`` is outside 1e-100..1e100,
     else 1: the D-G forms are quadratic in ``A``, so entries near 1e-162 square to 0 (and near
@@ -84,9 +87,11 @@ def _rounding_margin(A, Gt) -> float:
     :math:`A` of its real block, which the scalings often make small (:math:`\|\tilde G\|_F
     \|A\|_F` overstated the error 1e12-fold on a real block whose G approached infinity)."""
     n = A.shape[0] + A.shape[1]
-    a = float(np.linalg.norm(A))
-    ga = 0.0 if Gt is None else float(np.linalg.norm(np.abs(Gt) @ np.abs(A)))
-    return 4.0 * n * np.finfo(float).eps * (a * a + 2.0 * ga)
+    a2 = float(np.vdot(A, A).real)                  # ||A||_F^2
+    if Gt is None:
+        return 4.0 * n * _EPS * a2
+    GA = np.abs(Gt) @ np.abs(A)
+    return 4.0 * n * _EPS * (a2 + 2.0 * math.sqrt(float(np.vdot(GA, GA))))
 
 
 # relative rounding margin (of beta**2) above which the certificate is recomputed in extended

@@ -86,6 +86,9 @@ class Block:
         return self.kind == "full" or self.rows == 1
 
 
+_TINY = float(np.finfo(float).tiny)
+
+
 class BlockStructure:
     r"""Block-diagonal structure :math:`\boldsymbol\Delta = \{\operatorname{diag}(\Delta_1,\dots,\Delta_m)\}`.
 
@@ -218,18 +221,18 @@ class BlockStructure:
             raise ModelError(f"M is {M.shape[0]}x{M.shape[1]} but the block structure {self!r} "
                              f"needs {self.ncols}x{self.nrows} (rows = total block columns, "
                              f"columns = total block rows)")
-        M = M.astype(complex)
-        if not np.all(np.isfinite(M)):
+        M = M.astype(complex, order="C")
+        # real and imaginary parts side by side (a view of the new array)
+        parts = M.view(float)
+        if not np.isfinite(parts).all():
             raise ModelError("M contains non-finite entries")
         # subnormal parts (below 2.2e-308) next to normal entries: zero them.  mu moves by about
         # 1e-308 relative, and the scalings would otherwise meet numbers that some loaded
         # libraries make the CPU read as zero (0/0 inside the SVD)
-        tiny = np.finfo(float).tiny
-        if np.abs(M).max(initial=0.0) >= tiny:
-            re, im = M.real.copy(), M.imag.copy()
-            re[np.abs(re) < tiny] = 0.0
-            im[np.abs(im) < tiny] = 0.0
-            M = re + 1j * im
+        a = np.abs(parts)
+        small = a < _TINY
+        if a.max(initial=0.0) >= _TINY and (small & (a > 0.0)).any():
+            parts[small] = 0.0
         return M
 
     # -- perturbations -----------------------------------------------------
