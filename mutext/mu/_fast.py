@@ -274,7 +274,7 @@ class _DGParams:
             # H = (r r^T) o sum_i c_i S_i (see _stack): the inner loop of the default bound, in
             # few numpy calls
             if self._stack_of is not M:
-                self._stack(M)
+                self._stack(M)      # a call from outside a descent (_upper_fast builds it)
             m = self.m
             e2 = np.exp(2.0 * x[:m])
             ri = np.exp(-x[:m])[S.row_block]
@@ -670,6 +670,8 @@ def _upper_fast(M, S: BlockStructure, params: _DGParams, x0=None, B0=None, ftol:
         for gs in params.gslots:
             if gs is not None:
                 x0[gs] = np.clip(x0[gs], -_G_CLIP, _G_CLIP)
+    if params.diag:
+        params._stack(M)    # the terms of this matrix (a caller may reuse one array for several)
     if not params.use_g:
         beta0 = 1.0         # no G: beta0 does not enter
     elif beta0 is None:
