@@ -541,10 +541,11 @@ def _bfgs(fun, x0, B0=None, max_iter: int = 100, ftol: float = 1e-10, max_step: 
             break
         if kinked and not cl_fail and cl is not None and 1.0 - cl[0] < _CLUSTER_GAP:
             d, pred = _cluster_step(cl, B)
-            if pred >= 0.0 and np.all(np.isfinite(d)):
+            if (pred >= 0.0 or (small and -pred < _PRED_STOP * tol)) and np.all(np.isfinite(d)):
                 # the model of the two top eigenvalues has its minimum here (a stationary point
-                # of lambda_max): without this stop a failing line search along -B g and this
-                # step alternated until the evaluation budget was spent
+                # of lambda_max; without this stop a failing line search along -B g and this
+                # step alternated until the evaluation budget was spent), or the last step
+                # gained less than tol and this one is predicted to gain less
                 stop = "ftol"
                 break
             if pred < 0 and np.all(np.isfinite(d)):
