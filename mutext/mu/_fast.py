@@ -115,6 +115,23 @@ class _DGParams:
         e = np.exp(x[:self.m])
         return (e[self.S.col_block][:, None] * M) * (1.0 / e)[self.S.row_block]
 
+    def _cluster_parts(self, M, V, beta0, gs, x):
+        """(A, Q, P = AQ, Y = AQ - j G~^H Q) at the point last evaluated: Q its two top
+        eigenvectors; shared by the model and its Hessian (kept for the point they are asked at)."""
+        key = self.cluster
+        if self._parts is not None and self._parts[0] is key:
+            return self._parts[1]
+        A = self._scaled(M, x)
+        Q = V[:, :-3:-1]
+        P = A @ Q
+        Y = P.copy()
+        if gs is not None:
+            Y[self.gcol] -= 1j * (beta0 * gs)[:, None] * Q[self.grow]
+        self._parts = (key, (A, Q, P, Y))
+        return A, Q, P, Y
+
+    _parts = None
+
     def model(self, gap: float):
         """(lambda_2/lambda_1, C) at the point last evaluated, C a function returning the
         matrices of :meth:`_cluster` (built only when the descent steps on them) if the
@@ -135,12 +152,7 @@ class _DGParams:
         (w1/w0, C) with C[k] = Q^H (dH/dx_k) Q / w0 (2 x 2, all coordinates), Q the two top
         eigenvectors (largest first).  With ``A`` and ``Y = AQ - j G'^H Q``,
         :math:`Q^H\partial_kHQ = R_k^HY + Y^HR_k`, :math:`R_k = \partial_kA\,Q`."""
-        A = self._scaled(M, x)
-        Q = V[:, :-3:-1]
-        P = A @ Q
-        Y = P.copy()
-        if gs is not None:
-            Y[self.gcol] -= 1j * (beta0 * gs)[:, None] * Q[self.grow]
+        A, Q, P, Y = self._cluster_parts(M, V, beta0, gs, x)
         AY = A.conj().T @ Y
         # R_k^H Y summed over the rows of block k: columns (col_block) and rows (row_block)
         T = ((P.conj()[:, :, None] * Y[:, None, :]).reshape(P.shape[0], 4).T @ self.El
@@ -174,15 +186,11 @@ class _DGParams:
         ``y`` of entry (r, c) adds :math:`j\beta_0\cosh(y)\,e_r A_{c,:}` (second derivative
         :math:`\sinh` for ``cosh``; :math:`A\to\partial_kA` across)."""
         M, w, V, beta0, gs, x = self.cluster
-        A = self._scaled(M, x)
+        A, Q, P, Y = self._cluster_parts(M, V, beta0, gs, x)
         m, N, n = self.m, self.size, A.shape[1]
         sel = self.sel
-        Q = V[:, :-3:-1]
-        P = A @ Q
-        Y = P.copy()
         if gs is not None:
             jg = 1j * beta0 * gs
-            Y[self.gcol] -= jg[:, None] * Q[self.grow]
         dA = A[None] * sel                                      # (m, ncols, nrows)
         R = dA @ Q                                              # (m, ncols, 2)
         DQ = np.empty((N, n, 2), complex)
@@ -455,7 +463,8 @@ def _upper_fast(M, S: BlockStructure, params: _DGParams, x0=None, B0=None, ftol:
         cl = params.model(_CLUSTER_GAP)
         if cl is None or cl[1] is None:
             return cl
-        return cl[0], lambda: cl[1]()[free], lambda U: params.cluster_hessian(U)[np.ix_(free, free)]
+        return cl[0], lambda: cl[1]()[free], lambda U: params.cluster_hessian(U)[ixf]
+    ixf = np.ix_(free, free)
     cluster = cluster_model if kinks and params.diag and S.nrows >= 2 else None
     params.want_cluster, params.cluster = cluster is not None, None
     try:
