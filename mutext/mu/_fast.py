@@ -506,17 +506,24 @@ def _fast_polish(M, S: BlockStructure, params: _DGParams, x0=None):
     """The fast bound to full accuracy: long descents, restarted from the point reached
     (BFGS can stall at a kink of lambda_max, e.g. with repeated real scalars, and a
     fresh Hessian approximation often continues).  Returns (MuUpper, coordinates)."""
-    up, x, _ = _fast_at(M, S, params, x0, None, ftol=1e-12, max_eval=400)
+    info = {}
+    up, x, _ = _fast_at(M, S, params, x0, None, ftol=1e-12, max_eval=400, info=info)
+    b0 = info.get("beta0")
     for _ in range(_FAST_RESTARTS):
         if x is None:
             break
-        # a restart as a warm start (G-hat clipped, its scale taken afresh): a perturbation that
-        # leaves the flat valleys where a real block's d -> 0 (on the loop matrix of
-        # tests/test_refine.py restarting at the very point stalled 2e-4 above AB13MD)
-        up2, x2, _ = _fast_at(M, S, params, x, None, ftol=1e-12, max_eval=400)
-        if not up2.value < up.value * (1 - 1e-10):
+        # a restart at the very point (fresh Hessian approximation; what repeated real scalars
+        # need), else one as a warm start (G-hat clipped, its scale taken afresh): a perturbation
+        # out of the flat valleys where a real block's d -> 0 (on the loop matrix of
+        # tests/test_refine.py restarts at the very point stalled 2e-4 above AB13MD)
+        for beta0 in (b0, None):
+            info = {}
+            up2, x2, _ = _fast_at(M, S, params, x, None, ftol=1e-12, max_eval=400, info=info, beta0=beta0)
+            if up2.value < up.value * (1 - 1e-10):
+                break
+        else:
             break
-        up, x = up2, x2
+        up, x, b0 = up2, x2, info.get("beta0")
     return up, x
 
 
