@@ -2,7 +2,9 @@ r"""Upper bound by D-G scalings without an SDP: quasi-Newton descent ([YND]_, [L
 
 BFGS with the weak Wolfe line search on :math:`\log\lambda_{\max}` of the
 congruent form, in coordinates that carry over from one frequency to the next
-(``mu_upper(method="fast")`` and the warm-started sweep of :func:`mu_sweep`).
+(``mu_upper(method="fast")`` and the warm-started sweep of :func:`mu_sweep`): here the
+coordinates, the form, its gradient and the model of its two largest eigenvalues
+(:class:`_DGParams`) and the drivers; the descent itself is in ``_descent.py``.
 """
 from __future__ import annotations
 
