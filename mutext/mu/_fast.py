@@ -13,13 +13,10 @@ import math
 import numpy as np
 from scipy.linalg.lapack import zheevd as _zheevd
 
-from ._certificate import MuUpper, _d_from_matrices, _diag_result
+from ._certificate import _EPS, MuUpper, _d_from_matrices, _diag_result
 from ._descent import _CLUSTER_GAP, _absmax, _bfgs
 from ._osborne import _osborne
 from ._structure import BlockStructure, _norm2
-
-
-_EPS_N = float(np.finfo(float).eps)
 
 
 class _DGParams:
@@ -300,7 +297,7 @@ class _DGParams:
             lam, v = float(w[-1]), V[:, -1]
             # rounding noise of log lambda here: eps times the size of H (its extreme eigenvalues)
             # over lambda; a G-hat approaching infinity makes H graded and this large
-            self.noise = _EPS_N * S.nrows * max(-float(w[0]), lam) / lam if lam > 0 else np.inf
+            self.noise = _EPS * S.nrows * max(-float(w[0]), lam) / lam if lam > 0 else np.inf
             if not grad:
                 return lam, None
             if self.want_cluster:
