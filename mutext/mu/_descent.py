@@ -51,13 +51,12 @@ def _cluster_step(cl, B):
     if len(cl) > 2 and cl[2] is not None and 1.0 - r < _HESSIAN_GAP and np.all(np.isfinite(u)):
         U = 0.5 * np.array([[1.0 + u[0], u[1] + 1j * u[2]], [u[1] - 1j * u[2], 1.0 - u[0]]])
         W = cl[2](U)
-        q = np.linalg.eigvalsh(W)
-        if np.all(np.isfinite(q)) and q[-1] > 0:
+        q, V, info = _dsyev(W)
+        if info == 0 and np.all(np.isfinite(q)) and q[-1] > 0:
             # positive definite: along the kink the Lagrangian is convex at a minimiser; a small
             # shift where it is not (far from one)
             tau = max(0.0, -q[0]) + 1e-10 * q[-1]
-            Bw = np.linalg.inv(W + tau * np.eye(W.shape[0]))
-            d2, pred2, _ = _cluster_solve(gc, J, r0, r, 0.5 * (Bw + Bw.T))
+            d2, pred2, _ = _cluster_solve(gc, J, r0, r, (V / (q + tau)) @ V.T)
             if np.all(np.isfinite(d2)) and pred2 < 0:
                 return d2, pred2
     return d, pred
@@ -129,8 +128,33 @@ def _bfgs_update(B, s, y):
     return B + ((sy + y @ By) * rho * rho) * (s[:, None] * s) - rho * (By[:, None] * s + s[:, None] * By)
 
 
+def _inverse_metric(W):
+    """A positive definite inverse of the symmetric ``W`` (a Hessian): its eigenvalues by absolute
+    value, floored at 1e-3 of the largest (a Newton metric that never points uphill, and bounded
+    along flat or concave directions); None if ``W`` has no positive scale."""
+    q, V, info = _dsyev(W)
+    if info != 0 or not np.all(np.isfinite(q)):
+        return None
+    a = np.abs(q)
+    top = float(a.max()) if a.size else 0.0
+    if not top > 0:
+        return None
+    a = np.maximum(a, 1e-3 * top)
+    return (V / a) @ V.T
+
+
+def _first_metric(B0, hessian, n: int):
+    """(inverse metric, whether it is the identity): a copy of ``B0``; without it the inverse of
+    ``hessian()`` (:func:`_inverse_metric`) where that exists, else the identity."""
+    if B0 is not None:
+        return B0.copy(), False
+    W = hessian() if hessian is not None else None
+    B = None if W is None else _inverse_metric(W)
+    return (np.eye(n), True) if B is None else (B, False)
+
+
 def _bfgs(fun, x0, B0=None, max_iter: int = 100, ftol: float = 1e-10, max_step: float = 1.0,
-          max_eval: int = 400, info: dict | None = None, cluster=None, noise=None):
+          max_eval: int = 400, info: dict | None = None, cluster=None, noise=None, hessian=None):
     r"""Minimise a (possibly nonsmooth at optimum) function by BFGS with a weak Wolfe line search.
 
     The line search of Lewis and Overton [LO]_ (bisection/doubling on the
@@ -147,7 +171,9 @@ def _bfgs(fun, x0, B0=None, max_iter: int = 100, ftol: float = 1e-10, max_step: 
     the step is taken on that model (Armijo backtracking on its predicted decrease), with
     the gradient step as fallback.  ``noise`` (optional) returns the rounding noise of ``f`` at
     the point last evaluated: a step gaining less than ``_NOISE_FACTOR`` times it counts as
-    gaining less than ``ftol`` (a descent in rounding noise only wanders).
+    gaining less than ``ftol`` (a descent in rounding noise only wanders).  ``hessian``
+    (optional, with ``B0`` None) returns the Hessian of ``f`` at the point last evaluated (or
+    None): the first metric is then its inverse (:func:`_inverse_metric`), not the identity.
     """
     def tol_here():
         return max(ftol, _NOISE_FACTOR * noise()) if noise is not None else ftol
@@ -157,8 +183,8 @@ def _bfgs(fun, x0, B0=None, max_iter: int = 100, ftol: float = 1e-10, max_step: 
     tol = tol_here()
     cl = cluster() if cluster is not None else None
     nev, n, small = 1, x.size, 0
-    B = np.eye(n) if B0 is None else B0.copy()
-    reset = B0 is None
+    # the Hessian only where a step will be taken (not at a stationary start)
+    B, reset = _first_metric(B0, hessian if _absmax(g) > 1e-13 else None, n)
     stop, moved = "budget", False
     kinked = _CLUSTER_MODE == "always"
     cl_fail = False         # the model step failed at the current point

@@ -109,124 +109,181 @@ class _DGParams:
             mp[m + np.arange(r), self.real_idx] = 2.0
             self._map2, self._er2 = mp, 2.0 * self.Er
 
-    def _scaled(self, M, x):
-        """A = D_l M D_r^-1 for diagonal scalings (the model of the top two eigenvalues)."""
-        e = np.exp(x[:self.m])
-        return (e[self.S.col_block][:, None] * M) * (1.0 / e)[self.S.row_block]
-
-    def _cluster_parts(self, M, V, beta0, gs, x):
-        """(A, Q, P = AQ, Y = AQ - j G~^H Q) at the point last evaluated: Q its two top
-        eigenvectors; shared by the model and its Hessian (kept for the point they are asked at)."""
-        key = self.cluster
-        if self._parts is not None and self._parts[0] is key:
-            return self._parts[1]
-        A = self._scaled(M, x)
-        Q = V[:, :-3:-1]
-        P = A @ Q
-        Y = P.copy()
-        if gs is not None:
-            Y[self.gcol] -= 1j * (beta0 * gs)[:, None] * Q[self.grow]
-        self._parts = (key, (A, Q, P, Y))
-        return A, Q, P, Y
-
-    _parts = None
-
     def model(self, gap: float):
-        """(lambda_2/lambda_1, C) at the point last evaluated, C a function returning the
-        matrices of :meth:`_cluster` (built only when the descent steps on them) if the
-        relative gap of the two is below ``gap``, else None; None without that evaluation."""
+        """(lambda_2/lambda_1, C, W) at the point last evaluated: C a function returning the
+        matrices of :meth:`_cluster` and W one returning :meth:`cluster_hessian` for a multiplier
+        (both for this evaluation, built only when the descent steps on them) if the relative gap
+        of the two is below ``gap``, else (lambda_2/lambda_1, None, None); None without that
+        evaluation."""
         cl = self.cluster
         if cl is None:
             return None
-        w = cl[1]
+        w = cl[0]
         if w.size < 2 or not w[-1] > 0:
             return None
         r = float(w[-2] / w[-1])
         if not 1.0 - r < gap:
-            return r, None
-        return r, lambda: self._cluster(*cl)[1]
+            return r, None, None
+        return r, lambda: self._cluster(cl)[1], lambda U: self.cluster_hessian(U, cl)
 
-    def _cluster(self, M, w, V, beta0, gs, x):
+    def _cluster_terms(self, cl):
+        r"""What the model of the two largest eigenvalues and its Hessian share at the evaluation
+        ``cl`` (kept for the last one asked): Q the two top eigenvectors (largest first), their
+        eigenvalues, :math:`u = RQ`, :math:`P_{\alpha} = \partial_\alpha K\,u` ``(N, n, 2)``,
+        :math:`u^HS_iu` ``(T, 2, 2)``, :math:`Q^HE_\alpha Q` ``(m, 2, 2)`` and the sums of the
+        eigenvalue pairs."""
+        if self._terms is not None and self._terms[0] is cl:
+            return self._terms[1]
+        w, V, coef, ri, cp, _ = cl
+        n, m, N = w.size, self.m, self.size
+        Q = V[:, :-3:-1]
+        lq = w[:-3:-1]
+        uq = ri[:, None] * Q
+        Su = self._stack_m @ uq                                      # (T, n, 2), T = N terms
+        Dc = np.zeros((N, N))
+        Dc[:m] = self._map2.T * coef
+        if self.nreal:
+            Dc[m + self.yidx, m + self.yidx] = cp
+        P = (Dc @ Su.reshape(N, 2 * n)).reshape(N, n, 2)
+        Qi = uq.conj().T[None] @ Su
+        EQ = ((Q.conj()[:, :, None] * Q[:, None, :]).reshape(n, 4).T @ self.Er).T.reshape(m, 2, 2)
+        out = (Q, lq, uq, P, Qi, EQ, lq[:, None] + lq[None, :], Dc)
+        self._terms = (cl, out)
+        return out
+
+    _terms = None
+
+    def _cluster(self, cl):
         r"""First-order model of the two largest eigenvalues of H, divided by the largest:
-        (w1/w0, C) with C[k] = Q^H (dH/dx_k) Q / w0 (2 x 2, all coordinates), Q the two top
-        eigenvectors (largest first).  With ``A`` and ``Y = AQ - j G'^H Q``,
-        :math:`Q^H\partial_kHQ = R_k^HY + Y^HR_k`, :math:`R_k = \partial_kA\,Q`."""
-        A, Q, P, Y = self._cluster_parts(M, V, beta0, gs, x)
-        AY = A.conj().T @ Y
-        # R_k^H Y summed over the rows of block k: columns (col_block) and rows (row_block)
-        T = ((P.conj()[:, :, None] * Y[:, None, :]).reshape(P.shape[0], 4).T @ self.El
-             - (Q.conj()[:, :, None] * AY[:, None, :]).reshape(Q.shape[0], 4).T @ self.Er)
-        T = T.T.reshape(self.m, 2, 2)
-        C = np.empty((self.size, 2, 2), complex)
-        C[:self.m] = T + T.conj().transpose(0, 2, 1)
-        if gs is not None:
-            X = Q[self.grow].conj()[:, :, None] * P[self.gcol][:, None, :]
-            C[self.m:] = (1j * beta0 * np.cosh(x[self.m:]))[:, None, None] * (X - X.conj().transpose(0, 2, 1))
+        (w1/w0, C) with :math:`C_\alpha = Q^H\partial_\alpha HQ/\lambda_1` (2 x 2, all
+        coordinates), :math:`Q^H\partial_\alpha HQ = \sum_i\partial_\alpha c_i\,u^HS_iu
+        - (\lambda_a+\lambda_b)\,Q^HE_\alpha Q` (the terms of :meth:`_stack`, :math:`u = RQ`)."""
+        Q, lq, uq, P, Qi, EQ, ls, Dc = self._cluster_terms(cl)
+        w, N, m = cl[0], self.size, self.m
+        C = (Dc @ Qi.reshape(N, 4)).reshape(N, 2, 2)
+        C[:m] -= ls * EQ
         return float(w[-2] / w[-1]), C / w[-1]
 
-    def cluster_hessian(self, U):
+    def cluster_hessian(self, U, cl=None):
         r"""Hessian of the Lagrangian :math:`\operatorname{Re}\operatorname{tr}(U\,Q^HH(x)Q)` of the
-        two largest eigenvalues at the point last evaluated (diagonal scalings; Overton's
-        second-order model of a cluster), divided by the largest eigenvalue: all coordinates,
-        ``U`` a Hermitian ``2 x 2`` matrix (the multiplier of the cluster, trace 1).
+        two largest eigenvalues at the evaluation ``cl`` (default: the last; diagonal scalings;
+        Overton's second-order model of a cluster), divided by the largest eigenvalue: all
+        coordinates, ``U`` a Hermitian ``2 x 2`` matrix (the multiplier of the cluster, trace 1).
 
         .. math::
-            W_{ik} = \operatorname{Re}\operatorname{tr}\bigl(U Q^H\partial_{ik}H\,Q\bigr)
-            + 2\operatorname{Re}\sum_{l>2}\frac{\operatorname{tr}(U F_{i,l}^H F_{k,l})}{\lambda - \lambda_l},
-            \qquad F_{i,l} = v_l^H\,\partial_iH\,Q,
+            W_{\alpha\beta} = \operatorname{Re}\operatorname{tr}\bigl(U Q^H\partial_{\alpha\beta}H\,Q\bigr)
+            + 2\operatorname{Re}\sum_{l>2}\frac{\operatorname{tr}(U F_{\alpha,l}^H F_{\beta,l})}{\lambda - \lambda_l},
+            \qquad F_{\alpha,l} = v_l^H\,\partial_\alpha H\,Q,
 
-        with :math:`Q` the top two eigenvectors and :math:`(\lambda_l, v_l)` the other eigenpairs
-        (:math:`\lambda` the cluster's eigenvalue of each column of :math:`Q`, averaged over
-        the pair ``U`` couples).  Every derivative of ``H`` is :math:`Z + Z^H`, and with
-        :math:`K = A^H + j\tilde G`, :math:`Y = K^HQ`, :math:`P = AQ`, :math:`R_k = \partial_kA\,Q`
-        (:math:`\partial_kA = A\circ s_k`, ``s_k`` the +-1 pattern of block ``k``):
-        :math:`\partial_kH\,Q = \partial_kA^HY + KR_k`; :math:`Q^H\partial_{ik}H\,Q` has
-        :math:`Y^H(A\circ s_i\circ s_k)Q + R_i^HR_k` and its transpose; a G-hat coordinate
-        ``y`` of entry (r, c) adds :math:`j\beta_0\cosh(y)\,e_r A_{c,:}` (second derivative
-        :math:`\sinh` for ``cosh``; :math:`A\to\partial_kA` across)."""
-        M, w, V, beta0, gs, x = self.cluster
-        A, Q, P, Y = self._cluster_parts(M, V, beta0, gs, x)
-        m, N, n = self.m, self.size, A.shape[1]
-        sel = self.sel
-        if gs is not None:
-            jg = 1j * beta0 * gs
-        dA = A[None] * sel                                      # (m, ncols, nrows)
-        R = dA @ Q                                              # (m, ncols, 2)
-        DQ = np.empty((N, n, 2), complex)
-        # K^H Q = Y (so Q^H K = Y^H) and K R_k = A^H R_k + j G~ R_k
-        KR = A.conj().T[None] @ R
-        if gs is not None:
-            KR[:, self.grow] += jg[:, None] * R[:, self.gcol]
-        DQ[:m] = dA.conj().transpose(0, 2, 1) @ Y + KR
+        with :math:`(\lambda_l, v_l)` the other eigenpairs (:math:`\lambda` the cluster's
+        eigenvalue of each column of :math:`Q`, averaged over the pair ``U`` couples).  In the
+        terms of :meth:`hessian` with :math:`u = RQ`: :math:`F_{\alpha,l} = v_l^H(r\circ P_\alpha)
+        - (\lambda_l+\lambda_b)v_l^HE_\alpha Q`, and :math:`q_a^H\partial_{\alpha\beta}Hq_b` has
+        :math:`\delta_{\alpha\beta}(\lambda_a+\lambda_b)q_a^HE_\alpha q_b`,
+        :math:`(E_\alpha q_a)^HH(E_\beta q_b)` and its mirror, :math:`-(E_\alpha u_a)^HP_{\beta b}
+        - P_{\beta a}^HE_\alpha u_b` and its mirror, and :math:`\sum_i\partial_{\alpha\beta}c_i\,
+        u_a^HS_iu_b`."""
+        if cl is None:
+            cl = self.cluster
+        Q, lq, uq, P, Qi, EQ, ls, Dc = self._cluster_terms(cl)
+        w, V, coef, ri, cp, _ = cl
+        n, m, N = w.size, self.m, self.size
         UT = U.T
-        # second derivatives, x-x: sum over entries of s_i s_k (A o Psi), Psi = conj(Y) U^T Q^T
-        Psi = (Y.conj() @ UT) @ Q.T
-        sf = sel.reshape(m, -1)
-        W = np.empty((N, N))
-        Wxx = 2.0 * ((sf * (A * Psi).ravel()) @ sf.T
-                     + R.conj().reshape(m, -1) @ (R @ U).reshape(m, -1).T).real
-        W[:m, :m] = Wxx
-        if gs is not None:
-            c = beta0 * np.cosh(x[m:])
-            gr, gc = self.grow, self.gcol
-            # D_j Q = j c_j (e_gr P[gc] - conj(A[gc])^T Q[gr])
-            jc = 1j * c
-            DQy = (-jc[:, None, None] * A[gc].conj()[:, :, None]) * Q[gr][:, None, :]
-            DQy[self.yidx, gr] += jc[:, None] * P[gc]
-            DQ[m:] = DQy
-            qu = Q[gr].conj()                                   # (r, 2)
-            # tr(U Q^H E_j B Q) = conj(Q[gr]) . (B[gc] Q U): B = A (y-y) or dA_k (x-y)
-            tyy = (qu * (P[gc] @ U)).sum(1)
-            W[m:, m:] = np.diag((-2.0 * beta0) * gs * tyy.imag)
-            txy = (qu[None] * (R[:, gc] @ U)).sum(2)
-            W[:m, m:] = (-2.0 * c) * txy.imag
-            W[m:, :m] = W[:m, m:].T
-        F = V[:, :-2].conj().T[None] @ DQ                       # (N, n-2, 2)
-        dl = 1.0 / (w[-1:-3:-1][None, :] - w[:-2, None])        # (n-2, 2)
+        Z = np.empty((n, 2 * m + 2 * N), complex)
+        Z[:, :2 * m] = (self.Er[:, :, None] * Q[:, None, :]).reshape(n, 2 * m)
+        Z[:, 2 * m:] = (ri[:, None, None] * P.transpose(1, 0, 2)).reshape(n, 2 * N)
+        Z = V.conj().T @ Z
+        YQ = Z[:, :2 * m].reshape(n, m, 2)
+        F = Z[:, 2 * m:].reshape(n, N, 2)
+        F[:, :m] -= (w[:, None, None] + lq[None, None, :]) * YQ
+        Fl = F[:-2]
+        dl = 1.0 / (lq[None, :] - w[:-2, None])
         Tw = 0.5 * (dl[:, :, None] + dl[:, None, :]) * UT[None]
-        Fl = F.transpose(1, 0, 2)                               # (n-2, N, 2)
-        W += 2.0 * ((Fl.conj() @ Tw) @ Fl.transpose(0, 2, 1)).sum(0).real
-        return 0.5 * (W + W.T) / w[-1]
+        W = 2.0 * ((Fl.conj() @ Tw) @ Fl.transpose(0, 2, 1)).sum(0).real
+        A_ = (YQ.conj() @ UT) * w[:, None, None]
+        Z1 = A_.transpose(1, 0, 2).reshape(m, 2 * n) @ YQ.transpose(1, 0, 2).reshape(m, 2 * n).T
+        W[:m, :m] += (Z1 + Z1.T).real
+        T1 = 2.0 * ((uq.conj()[None] * (P @ U)).sum(2) @ self.Er).real.T
+        W[:m] -= T1
+        W[:, :m] -= T1.T
+        qU = (Qi.reshape(N, 4) @ UT.ravel()).real
+        cq = coef * qU
+        e1 = (EQ.reshape(m, 4) @ (UT * ls).ravel()).real
+        if self.nreal:
+            t = 2.0 * cp * qU[m:]
+            W.ravel()[self._hidx(N)] += np.concatenate((e1 + 2.0 * (cq @ self._map2), t, t, cq[m:]))
+        else:
+            W.ravel()[self._hidx(N)] += e1 + 2.0 * (cq @ self._map2)
+        return W / w[-1]
+
+    _last = None
+
+    def hessian(self):
+        r"""Hessian of :math:`\log\lambda_{\max}(H)` at the point last evaluated with its gradient
+        (diagonal scalings, all coordinates), or None where the top eigenvalue is not simple.
+
+        With :math:`H = RKR`, :math:`R = \operatorname{diag}(r)`, :math:`K = \sum_i c_iS_i` (see
+        :meth:`_stack`), :math:`u = Rv` and :math:`E_\alpha` the rows of block :math:`\alpha`
+        (:math:`\partial_\alpha R = -E_\alpha R`; zero for a G-hat coordinate), the second derivative
+        of a simple eigenvalue (second-order perturbation theory) is
+
+        .. math::
+            \lambda_{\alpha\beta} = v^H\partial_{\alpha\beta}H\,v
+            + 2\operatorname{Re}\sum_{l\ne 1}\frac{\overline{F_{l\alpha}}F_{l\beta}}{\lambda-\lambda_l},
+            \qquad F_{l\alpha} = v_l^H\partial_\alpha H\,v
+            = v_l^H(r\circ P_\alpha) - (\lambda+\lambda_l)\,v_l^HE_\alpha v,
+
+        :math:`P_\alpha = \partial_\alpha K\,u`, and :math:`v^H\partial_{\alpha\beta}H\,v =
+        \delta_{\alpha\beta}2\lambda\|E_\alpha v\|^2 + 2\operatorname{Re}(E_\alpha v)^HH(E_\beta v)
+        - 2\operatorname{Re}[(E_\alpha u)^HP_\beta + (E_\beta u)^HP_\alpha]
+        + \sum_i\partial_{\alpha\beta}c_i\,u^HS_iu`.  One evaluation's worth of small products;
+        the descent's first metric (BFGS then starts with the curvature it would otherwise spend
+        its first iterations learning)."""
+        if self._last is None:
+            return None
+        w, V, u, Su, q, coef, ri, cp, g = self._last
+        lam = float(w[-1])
+        if not (w.size > 1 and lam > w[-2]):
+            return None
+        m, r = self.m, self.nreal
+        N = m + r
+        v = V[:, -1]
+        P = np.empty((N, w.size), complex)
+        P[:m] = (self._map2.T * coef) @ Su
+        if r:
+            P[m:] = cp[:, None] * Su[m:]
+        # one product for V^H E_alpha v (first m columns) and V^H (r o P_beta) (the rest)
+        Z = np.empty((w.size, m + N), complex)
+        Z[:, :m] = v[:, None] * self.Er
+        Z[:, m:] = ri[:, None] * P.T
+        Z = V.conj().T @ Z
+        Y, F = Z[:, :m], Z[:, m:]
+        F[:, :m] -= (lam + w)[:, None] * Y
+        Fo = F[:-1]
+        W = 2.0 * ((Fo.conj().T * (1.0 / (lam - w[:-1]))) @ Fo).real
+        T = 2.0 * ((u.conj()[:, None] * self.Er).T @ P.T).real   # 2 Re (E_alpha u)^H P_beta
+        W[:m, :m] += 2.0 * ((Y.conj().T * w) @ Y).real
+        W[:m] -= T
+        W[:, :m] -= T.T
+        # the terms on the diagonal and, with G-hat, at (x_k, y_j), (y_j, x_k), (y_j, y_j): by flat index
+        cq = coef * q
+        W.ravel()[self._hidx(N)] += np.concatenate(
+            ((v.real * v.real + v.imag * v.imag) @ self._er2 * lam + 2.0 * (cq @ self._map2),
+             2.0 * cp * q[m:], 2.0 * cp * q[m:], cq[m:]) if r else
+            ((v.real * v.real + v.imag * v.imag) @ self._er2 * lam + 2.0 * (cq @ self._map2),))
+        W /= lam
+        W -= np.multiply.outer(g, g)
+        return W if math.isfinite(W.sum()) else None
+
+    def _hidx(self, N):
+        """Flat indices into an N x N array of the x-x diagonal and the (x_k, y_j), (y_j, x_k),
+        (y_j, y_j) entries (see :meth:`hessian`)."""
+        if getattr(self, "_hidx_n", None) != N:
+            m, j = self.m, self.m + self.yidx
+            self._hidx_v = np.concatenate((np.arange(m) * (N + 1), self.real_idx * N + j, j * N + self.real_idx,
+                                           j * (N + 1)))
+            self._hidx_n = N
+        return self._hidx_v
 
     # -- small matrices from coordinates -------------------------------------
     @staticmethod
@@ -302,17 +359,21 @@ class _DGParams:
                 return lam, None
             if self.want_cluster:
                 # kept for the model of the top two eigenvalues, built only where they are close
-                self.cluster = (M, w, V, beta0, gs / beta0 if self.nreal else None, x)
+                self.cluster = (w, V, coef, ri, (beta0 * np.cosh(x[m:])) * e2[self.real_idx] if self.nreal else None, x)
             # d/dx of u^H (sum c_i S_i) u with u = r o v: the coefficients' own (2 c_i q_i on
             # their block) and -2 lambda |v|^2 over the block's rows from r
             u = ri * v
-            q = ((self._stack_m @ u) @ u.conj()).real
+            Su = self._stack_m @ u
+            q = (Su @ u.conj()).real
             gx = (coef * q) @ self._map2 - lam * ((v.real * v.real + v.imag * v.imag) @ self._er2)
             if self.nreal:
-                g = np.concatenate((gx, (beta0 * np.cosh(x[m:])) * e2[self.real_idx] * q[m:]))
+                cp = (beta0 * np.cosh(x[m:])) * e2[self.real_idx]
+                g = np.concatenate((gx, cp * q[m:]))
             else:
-                g = gx
-            return lam, g / max(lam, 1e-300)
+                cp, g = None, gx
+            g = g / max(lam, 1e-300)
+            self._last = (w, V, u, Su, q, coef, ri, cp, g)
+            return lam, g
         # general structure (repeated scalars): block-diagonal factors
         Lc = np.zeros((S.ncols, S.ncols), complex)
         Lri = np.zeros((S.nrows, S.nrows), complex)
@@ -408,7 +469,7 @@ _G_CLIP = 8.0
 
 def _upper_fast(M, S: BlockStructure, params: _DGParams, x0=None, B0=None, ftol: float = 1e-10,
                 max_eval: int = 400, info: dict | None = None, osborne_tol: float = 0.0,
-                kinks: bool = False, beta0: float | None = None):
+                kinks: bool = False, beta0: float | None = None, hessian0: bool = False):
     """Fast D (or D-G) bound at one matrix, from coordinates ``x0`` (None: Osborne balancing).
 
     Returns (MuUpper, x, inverse Hessian) with the value recomputed from the
@@ -418,6 +479,8 @@ def _upper_fast(M, S: BlockStructure, params: _DGParams, x0=None, B0=None, ftol:
     ``beta0``: the G-hat scale of an earlier descent at the same matrix (``info["beta0"]``
     of it) when ``x0`` is its end point: the restart then starts at exactly that point
     (no clipping of G-hat, which is for warm starts from another matrix).
+    ``hessian0`` (diagonal scalings, ``B0`` None): the descent's first metric is the inverse of
+    the exact Hessian at ``x0`` (:meth:`_DGParams.hessian`) instead of the identity.
     """
     if x0 is None:
         x0 = params.initial(np.exp(_osborne(M, S, tol=osborne_tol)))
@@ -462,14 +525,20 @@ def _upper_fast(M, S: BlockStructure, params: _DGParams, x0=None, B0=None, ftol:
         cl = params.model(_CLUSTER_GAP)
         if cl is None or cl[1] is None:
             return cl
-        return cl[0], lambda: cl[1]()[free], lambda U: params.cluster_hessian(U)[ixf]
+        C, W = cl[1], cl[2]
+        return cl[0], lambda: C()[free], lambda U: W(U)[ixf]
+
+    def hessian():
+        W = params.hessian()
+        return None if W is None else W[ixf]
     ixf = np.ix_(free, free)
     cluster = cluster_model if kinks and params.diag and S.nrows >= 2 else None
     params.want_cluster, params.cluster = cluster is not None, None
     try:
         with np.errstate(over="ignore", invalid="ignore"):
             f, y, B, nev = _bfgs(fun, x0[free], B0, ftol=ftol, max_eval=max_eval, info=info, cluster=cluster,
-                                 noise=(lambda: params.noise) if params.diag else None)
+                                 noise=(lambda: params.noise) if params.diag else None,
+                                 hessian=hessian if hessian0 and params.diag else None)
     finally:
         params.want_cluster, params.cluster = False, None
     x = x0.copy()
@@ -486,7 +555,8 @@ def _upper_fast(M, S: BlockStructure, params: _DGParams, x0=None, B0=None, ftol:
 
 def _fast_at(M, S: BlockStructure, params: _DGParams, x0=None, B0=None, ftol: float = 1e-10,
              max_eval: int = 400, info: dict | None = None, osborne_tol: float = 0.0,
-             kinks: bool = False, nrm: float | None = None, beta0: float | None = None):
+             kinks: bool = False, nrm: float | None = None, beta0: float | None = None,
+             hessian0: bool = False):
     """:func:`_upper_fast` with the shortcuts of :func:`mu_upper` (one full block, ``M = 0``,
     extreme norms); returns (MuUpper, coordinates or None, inverse Hessian or None).
     ``nrm``: sigma_max(M) if already known."""
@@ -495,10 +565,11 @@ def _fast_at(M, S: BlockStructure, params: _DGParams, x0=None, B0=None, ftol: fl
     if nrm == 0 or (len(S) == 1 and S.blocks[0].kind == "full"):
         return _diag_result(M, S, np.ones(len(S)), "sigma"), None, None
     if not 1e-100 <= nrm <= 1e100:
-        up, x, B = _upper_fast(M / nrm, S, params, x0, B0, ftol, max_eval, info, osborne_tol, kinks, beta0)
+        up, x, B = _upper_fast(M / nrm, S, params, x0, B0, ftol, max_eval, info, osborne_tol, kinks, beta0,
+                               hessian0)
         return MuUpper(float(up.value * nrm), up.method, d=up.d, Dl=up.Dl, Dr=up.Dr,
                        G=None if up.G is None else up.G * nrm, iterations=up.iterations), x, B
-    return _upper_fast(M, S, params, x0, B0, ftol, max_eval, info, osborne_tol, kinks, beta0)
+    return _upper_fast(M, S, params, x0, B0, ftol, max_eval, info, osborne_tol, kinks, beta0, hessian0)
 
 
 def _fast_polish(M, S: BlockStructure, params: _DGParams, x0=None):
@@ -530,6 +601,8 @@ def _fast_polish(M, S: BlockStructure, params: _DGParams, x0=None):
 _AUTO_FTOL = 1e-9
 #: evaluations of each restart of the default bound's descent
 _RESTART_EVALS = 50
+#: the default bound's descents start from the exact Hessian at their first point
+_HESSIAN0 = True
 
 
 def _fast_default(M, S: BlockStructure, params: _DGParams, always: bool = False, nrm: float | None = None):
@@ -542,7 +615,7 @@ def _fast_default(M, S: BlockStructure, params: _DGParams, always: bool = False,
     if nrm is None:
         nrm = _norm2(M)
     up, x, _ = _fast_at(M, S, params, None, None, ftol=_AUTO_FTOL, max_eval=300, info=info,
-                        osborne_tol=1e-2, kinks=True, nrm=nrm)
+                        osborne_tol=1e-2, kinks=True, nrm=nrm, hessian0=_HESSIAN0)
     nev = up.iterations
     for _ in range(_FAST_RESTARTS):
         if x is None or (info.get("stop") == "ftol" and not always):
@@ -552,7 +625,7 @@ def _fast_default(M, S: BlockStructure, params: _DGParams, always: bool = False,
             # would repeat the same failed line search
             break
         up2, x2, _ = _fast_at(M, S, params, x, None, ftol=_AUTO_FTOL, max_eval=_RESTART_EVALS, info=info, kinks=True,
-                              nrm=nrm, beta0=info.get("beta0"))
+                              nrm=nrm, beta0=info.get("beta0"), hessian0=_HESSIAN0)
         nev += up2.iterations
         if not up2.value < up.value * (1 - 1e-10):
             break
