@@ -111,6 +111,50 @@ def test_coalescing_eigenvalues_converge_fast():
     assert up.iterations <= 80
 
 
+def test_full_model_step_refused_near_the_kink_is_corrected():
+    """Two real scalars and a complex one (bench_mu case 1081), optimum at a kink: near it the
+    full model step converges quadratically but can raise lambda_max by the second-order change
+    of the pair's split (the Maratos effect).  Halving it made the last steps linear: 71
+    evaluations; the model step from the refused point is now tried first."""
+    ab13md = pytest.importorskip("slycot").ab13md
+    S = BlockStructure([Block.real(), Block.full(1), Block.real()])
+    M = np.array([
+        [0.4281625718014115 - 0.07716338182464112j, -0.5254818706299186 - 0.5500355806817635j,
+         -1.7488408542706027 - 1.0829143918113797j],
+        [0.9911788924675883 + 1.2127279802330702j, -1.3929004210673588 + 1.1659168982478834j,
+         -0.8681288968741957 - 0.938532260145088j],
+        [-0.08033619915513891 - 0.8023739656597458j, 2.0466385576640853 + 0.39851263863689335j,
+         -0.08359977360318807 + 1.7975419156757213j]])
+    up = mu_upper(M, S)
+    _certified(M, S, up)
+    ref = ab13md(M, np.array([1, 1, 1]), np.array([1, 2, 1]))[0]
+    assert up.value <= ref * (1 + 1e-9)
+    assert up.iterations <= 60
+
+
+def test_zigzag_across_a_kink_turns_to_the_model_step():
+    """A real, a complex, a real scalar and a 1 x 1 full block (bench_mu case 509): from the exact
+    Hessian at the start, BFGS zigzagged across the kink of lambda_max, every line search
+    refusing the full step once, for 60 evaluations before the model of the two eigenvalues was
+    tried (78 in all); a refused trial near the kink now turns to the model step."""
+    ab13md = pytest.importorskip("slycot").ab13md
+    S = BlockStructure([Block.real(), Block.scalar(), Block.real(), Block.full(1)])
+    M = np.array([
+        [-1.3000368490246244 + 0.9845171334917926j, -0.36958438915641084 + 0.555284052824785j,
+         -0.004193281529682508 - 1.1764599556385296j, 1.1635476838434624 - 0.5984252185579053j],
+        [0.19108309427909487 - 0.8583750280631749j, 1.424166347377141 - 1.0374209770724594j,
+         0.5382049284076261 - 1.8089313777476053j, 0.7277130863397637 - 0.45187206502741367j],
+        [1.1843244306580307 + 0.1630908981113859j, 0.6208789887384347 - 0.9719804266872513j,
+         -0.8747596529705491 - 0.48763598473649544j, 0.32575232744384996 - 0.6040526094138444j],
+        [0.19467366068697609 - 0.05529994843770057j, -0.11739270173434599 - 0.49104164486478347j,
+         0.8056614249083696 - 0.06622090686305342j, -0.22906562779111295 + 0.1931619004286333j]])
+    up = mu_upper(M, S)
+    _certified(M, S, up)
+    ref = ab13md(M, np.array([1, 1, 1, 1]), np.array([1, 2, 1, 2]))[0]
+    assert up.value <= ref * (1 + 1e-9)
+    assert up.iterations <= 30
+
+
 def test_cluster_hessian_against_finite_differences():
     """The Hessian of the cluster's Lagrangian with U = I/2 is the Hessian of the mean of the two
     largest eigenvalues, a smooth function while they stay apart from the rest: compared with
