@@ -23,15 +23,22 @@ class _DGPoint:
         return self.R @ (M.conj().T @ self.Dl @ M + 1j * (self.G @ M - M.conj().T @ self.G.conj().T)) @ self.R
 
 
-def _floored_scalings(Dl, Dr, S: BlockStructure, floor: float = 1e-8):
+def _block_spectra(Dr, S: BlockStructure):
+    """(largest eigenvalue of the block-diagonal ``Dr``, the eigenvalues and eigenvectors of each
+    of its blocks): what :func:`_floored_scalings` and :func:`_graded` both look at."""
+    parts = [np.linalg.eigh(Dr[rs, rs]) for rs in S.row_slices]
+    return max(float(ev.max()) for ev, _ in parts), parts
+
+
+def _floored_scalings(Dl, Dr, S: BlockStructure, floor: float = 1e-8, spectra=None):
     """The D scalings with each block's eigenvalues raised to at least ``floor`` times the
     largest, in D_l and D_r alike (so still a valid pair).  Where a parameter barely matters
     its optimal scaling tends to zero, D_r^(-1/2) to 1e8 and beyond, and the scaled form Q
-    to entries of 1e16 whose eigenvalues no longer have a correct digit."""
+    to entries of 1e16 whose eigenvalues no longer have a correct digit.  ``spectra``:
+    :func:`_block_spectra` of ``Dr`` if already computed."""
+    top, parts = _block_spectra(Dr, S) if spectra is None else spectra
     Dl, Dr = Dl.copy(), Dr.copy()
-    top = np.linalg.eigvalsh(Dr).max()
-    for b, rs, cs in zip(S.blocks, S.row_slices, S.col_slices):
-        ev, V = np.linalg.eigh(Dr[rs, rs])
+    for b, rs, cs, (ev, V) in zip(S.blocks, S.row_slices, S.col_slices, parts):
         if ev.min() >= floor * top:
             continue
         if b.kind == "full":
@@ -45,32 +52,32 @@ def _floored_scalings(Dl, Dr, S: BlockStructure, floor: float = 1e-8):
     return Dl, Dr
 
 
-def _graded(u, S: BlockStructure, floor: float = 1e-6) -> bool:
-    """Whether the fast scalings ``u`` have a D block below ``floor`` times the largest: a real
-    parameter that barely matters, whose d the descent drives towards 0 (and its G to infinity)
-    along a flat valley where it can stop short of the optimum (on the loop matrix of
-    tests/data/two_mass_loop_matrix_tiny_scaling.npy: d at 1.7e-7 of the largest, 3e-6 above
-    the LMI's bound, whose d is 7e-12); there the LMI is solved too."""
-    if u.Dr is None:
-        return False
-    top = np.linalg.eigvalsh(u.Dr).max()
-    return any(np.linalg.eigvalsh(u.Dr[rs, rs]).min() < floor * top for rs in S.row_slices)
+def _graded(spectra, floor: float = 1e-6) -> bool:
+    """Whether scalings with these :func:`_block_spectra` have a D block below ``floor`` times the
+    largest: a real parameter that barely matters, whose d the descent drives towards 0 (and
+    its G to infinity) along a flat valley where it can stop short of the optimum (on the loop
+    matrix of tests/data/two_mass_loop_matrix_tiny_scaling.npy: d at 1.7e-7 of the largest,
+    3e-6 above the LMI's bound, whose d is 7e-12); there the LMI is solved too."""
+    top, parts = spectra
+    return any(ev.min() < floor * top for ev, _ in parts)
 
 
 def _dg_point(M, S: BlockStructure) -> _DGPoint:
     """D-G scalings of one frequency: the fast descent's, or the LMI's where those do not
     reproduce the fast value to 1e-3 or are graded (:func:`_graded`: then the lower of the
-    two), their small D blocks floored (:func:`_floored_scalings`) unless that loses the 1e-3.  The value is sqrt(lambda_max(Q)) for the scalings kept, so
-    certified by them."""
+    two), their small D blocks floored (:func:`_floored_scalings`) unless that loses the 1e-3.
+    The value is sqrt(lambda_max(Q)) for the scalings kept, so certified by them."""
     best = None
     for method in ("fast", "lmi"):
         u = mu_upper(M, S, method=method)
+        spectra = None
         if u.Dl is None:          # one full block: sigma_max is mu
             nr, nc = M.shape[1], M.shape[0]
             tries = [_DGPoint(u.value, np.eye(nc), np.eye(nr), np.zeros((nr, nc)))]
         else:
+            spectra = _block_spectra(u.Dr, S)
             tries = []
-            for Dl, Dr in (_floored_scalings(u.Dl, u.Dr, S), (u.Dl, u.Dr)):
+            for Dl, Dr in (_floored_scalings(u.Dl, u.Dr, S, spectra=spectra), (u.Dl, u.Dr)):
                 ev, V = np.linalg.eigh(Dr)
                 R = (V * ev ** -0.5) @ V.conj().T
                 tries.append(_DGPoint(u.value, Dl, R, np.zeros_like(Dl) if u.G is None else u.G))
@@ -81,7 +88,7 @@ def _dg_point(M, S: BlockStructure) -> _DGPoint:
                 if best is None or pt.value < best.value:
                     best = pt
                 break
-        if best is not None and (method == "lmi" or not _graded(u, S)):
+        if best is not None and (method == "lmi" or spectra is None or not _graded(spectra)):
             return best
     if best is not None:
         return best
