@@ -99,16 +99,23 @@ def _rounding_margin(A, Gt) -> float:
 _MARGIN_RTOL = 1e-10
 
 
+def _dg_form(M, Dl, G):
+    r""":math:`X = M^HD_\ell M + j(GM - M^HG^H)` in double precision (no G term if ``G`` is None),
+    formed as :math:`M^H(D_\ell M)`: the order whose rounding :func:`_gevp_cholesky` bounds."""
+    X = M.conj().T @ (Dl @ M)
+    if G is not None:
+        GM = G @ M
+        X = X + 1j * (GM - GM.conj().T)
+    return X
+
+
 def _top_direction(M, Dl, Dr, G):
     """The top generalised eigenvector of ``(M^H Dl M + j(GM - M^H G^H), Dr)`` in double precision
     (any vector gives a lower bound through its Rayleigh quotient; this one nearly the best), or
     None where it cannot be computed (scalings beyond the double range among them)."""
     try:
         with np.errstate(over="ignore", invalid="ignore"):
-            X = M.conj().T @ Dl @ M
-            if G is not None:
-                GM = G @ M
-                X = X + 1j * (GM - GM.conj().T)
+            X = _dg_form(M, Dl, G)
             ev, Q = np.linalg.eigh(0.5 * (Dr + Dr.conj().T))
             if not ev[0] > 0:
                 return None
@@ -214,11 +221,9 @@ def _gevp_cholesky(M, Dl, Dr, G, beta: float) -> float | None:
     n = Dr.shape[0]
     with np.errstate(over="ignore", invalid="ignore", under="ignore"):
         aM = np.abs(M)
-        X = M.conj().T @ (Dl @ M)
+        X = _dg_form(M, Dl, G)
         E0 = aM.T @ (np.abs(Dl) @ aM)
         if G is not None:
-            GM = G @ M
-            X = X + 1j * (GM - GM.conj().T)
             E0 = E0 + 2.0 * (np.abs(G) @ aM)
         aDr = np.abs(Dr)
         if not (np.all(np.isfinite(X)) and np.all(np.isfinite(E0))):
