@@ -97,3 +97,25 @@ def test_size_check_counts_code_not_docstrings(tmp_path):
     long.write_text("def g():\n" + body + "\n    return x0\n")
     assert oversized([ok, long], tmp_path / "mutext") == [
         f"mutext/long.py:1: g has {FUNCTION_LINES + 2} lines of code"]
+
+
+def _escape_warnings(paths):
+    """Files whose source compiles with a warning (an invalid escape such as ``\\p`` in a docstring
+    that should be raw: a DeprecationWarning now, a SyntaxWarning from Python 3.12, an error later)."""
+    import warnings
+    out = []
+    for p in paths:
+        with warnings.catch_warnings():
+            warnings.simplefilter("error")
+            try:
+                compile(p.read_text(encoding="utf-8"), str(p), "exec")
+            except (SyntaxError, DeprecationWarning, SyntaxWarning) as exc:
+                out.append(f"{p}: {exc}")
+    return out
+
+
+def test_no_source_compiles_with_a_warning(tmp_path):
+    assert not _escape_warnings(sorted(PACKAGE.rglob("*.py")))
+    bad = tmp_path / "bad.py"
+    bad.write_text('def f():\n    """a :math:`\\partial` term"""\n')
+    assert _escape_warnings([bad])
