@@ -40,3 +40,28 @@ def test_demo_rotor_campbell_and_orbit(capsys):
     assert orb["direction"] == "forward"
     assert orb["semi_minor_m"] == pytest.approx(orb["semi_major_m"], rel=1e-6)
     assert orb["semi_major_m"] == pytest.approx(abs(H) * orb["kg_m"] * w ** 2, rel=0.02)
+
+
+@pytest.mark.slow
+def test_demo_rotor_plots_the_diagram_it_reports(tmp_path, capsys, monkeypatch):
+    """With --plots the Campbell figure is drawn from the diagram whose critical speeds the report
+    prints (computed once, at 49 speeds instead of 13): no second diagram is computed for it, and
+    the finer grid moves no critical speed by more than 1 rpm."""
+    import mutext.rotor.campbell_diagram as cdm
+    calls = []
+    real = cdm.campbell
+
+    def counted(*a, **k):
+        calls.append(len(a[1]))
+        return real(*a, **k)
+    monkeypatch.setattr(cdm, "campbell", counted)
+    assert main(["demo", "rotor", "--json", "--points", "50", "--plots", str(tmp_path)]) == 0
+    fine = json.loads(capsys.readouterr().out)["campbell"]
+    assert calls == [49] and (tmp_path / "rotor_campbell.png").stat().st_size > 0
+    assert main(["demo", "rotor", "--json", "--points", "50"]) == 0
+    coarse = json.loads(capsys.readouterr().out)["campbell"]
+    assert calls == [49, 13]
+    for k in (1, 2, 3):
+        a, b = fine[f"critical_speeds_{k}x_forward"], coarse[f"critical_speeds_{k}x_forward"]
+        assert len(a) == len(b)
+        assert all(abs(x["speed_rpm"] - y["speed_rpm"]) < 1.0 for x, y in zip(a, b))

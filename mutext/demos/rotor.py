@@ -47,7 +47,7 @@ def add_arguments(p):
     p.add_argument("--points", type=int, default=400, help="FRF frequencies in 20-225 Hz (default 400)")
 
 
-def solve(model_path=None, *, n_modes=6, points=400, band=(20.0, 225.0)):
+def solve(model_path=None, *, n_modes=6, points=400, band=(20.0, 225.0), campbell_speeds=13):
     """Everything the demo reports, as a dict (SI; frequencies in Hz).
 
     Parameters
@@ -60,11 +60,16 @@ def solve(model_path=None, *, n_modes=6, points=400, band=(20.0, 225.0)):
         FRF frequencies in ``band``.
     band : (float, float), optional
         Frequency band [Hz] of the FRF.
+    campbell_speeds : int, optional
+        Speeds of the Campbell diagram over 0-6000 rpm (13: every 500 rpm; ``--plots`` asks for
+        49, every 125 rpm, so that its figure and the reported critical speeds come from one
+        diagram).
     """
     from ..errors import ModelError
     from ..response import local_extrema
     from ..rotor import data_path, load_model
-    for name, v, lo in (("--modes (n_modes)", n_modes, 1), ("--points (points)", points, 2)):
+    for name, v, lo in (("--modes (n_modes)", n_modes, 1), ("--points (points)", points, 2),
+                        ("campbell_speeds", campbell_speeds, 2)):
         if isinstance(v, (bool, np.bool_)) or not isinstance(v, (int, np.integer)) or v < lo:
             raise ModelError(f"{name} must be an integer >= {lo}, got {v!r}")
     if points > 1_000_000:
@@ -95,8 +100,9 @@ def solve(model_path=None, *, n_modes=6, points=400, band=(20.0, 225.0)):
     from ..rotor.campbell_diagram import campbell
     from ..rotor.orbits import orbit
     from ..rotor.unbalance import unbalance_response
-    rpm = np.linspace(0.0, 6000.0, 13)
+    rpm = np.linspace(0.0, 6000.0, campbell_speeds)
     cd = campbell(r, rpm * np.pi / 30.0, n_modes=4, orders=(1, 2, 3))
+    out["_campbell"] = cd
     out["campbell"] = {"speeds_rpm": [float(x) for x in rpm],
                        "frequencies_hz": [[float(x) for x in row] for row in cd.frequencies_hz],
                        **{f"critical_speeds_{k}x_forward": [c.to_dict() for c in cd.critical_speeds(k, "forward")]
@@ -169,7 +175,8 @@ def run(args) -> int:
     if getattr(args, "plots", None) is not None:
         from .._files import output_directory
         output_directory(args.plots, "--plots")     # checked before the work, not after it
-    out = solve(args.model, n_modes=args.modes, points=args.points)
+    out = solve(args.model, n_modes=args.modes, points=args.points,
+                campbell_speeds=49 if getattr(args, "plots", None) is not None else 13)
     if args.json:
         from ..jsonio import print_json
         keys = ("natural_frequencies_hz", "whirl", "frf_peaks_hz", "frf_antiresonances_hz", "speed_rpm",
@@ -197,8 +204,11 @@ def run(args) -> int:
                   + ", ".join(f"{x:.1f}" for x in out["frf_antiresonances_hz"][key])
                   + f" Hz; max |H| = {abs(H[k]) * 1e6:.3g} um/A at {out['freqs_hz'][k]:.1f} Hz")
         cb = out["campbell"]
-        print("Campbell (healthy) [Hz] at " + ", ".join(f"{x:.0f}" for x in cb["speeds_rpm"][::4]) + " rpm: "
-              + "; ".join(", ".join(f"{x:.1f}" for x in row) for row in cb["frequencies_hz"][::4]))
+        # the rows nearest 0, 2000, 4000 and 6000 rpm, whatever the number of speeds computed
+        sp = np.asarray(cb["speeds_rpm"])
+        rows = sorted({int(np.argmin(np.abs(sp - x))) for x in (0.0, 2000.0, 4000.0, 6000.0)})
+        print("Campbell (healthy) [Hz] at " + ", ".join(f"{sp[i]:.0f}" for i in rows) + " rpm: "
+              + "; ".join(", ".join(f"{x:.1f}" for x in cb["frequencies_hz"][i]) for i in rows))
         for k in (1, 2, 3):
             crit = cb[f"critical_speeds_{k}x_forward"]
             print(f"{k}x forward critical speeds (0-6000 rpm): " + (", ".join(
@@ -272,10 +282,9 @@ def save_plots(out, directory):
     save(fig, "rotor_frf.png")
 
     from .. import plots
-    from ..rotor.campbell_diagram import campbell
-    r = out["rotors"]["healthy"]
-    cd = campbell(r, np.linspace(0.0, 2 * np.pi * 100.0, 41), n_modes=6, orders=(1, 2, 3))  # 0-6000 rpm
-    save(plots.campbell_figure(cd, title="Campbell diagram, healthy thesis rotor (1x, 2x, 3x)"), "rotor_campbell.png")
+    # the diagram whose critical speeds the report gives (solve(campbell_speeds=49) for a smooth figure)
+    save(plots.campbell_figure(out["_campbell"], title="Campbell diagram, healthy thesis rotor (1x, 2x, 3x)"),
+         "rotor_campbell.png")
     save(plots.unbalance_bode_figure(out["_unbalance_response"], critical=out["_critical_1x"],
                                      title=f"unbalance {UNBALANCE['kg_m'] * 1e6:g} g mm at station "
                                            f"{UNBALANCE['station']}, healthy rotor"), "rotor_unbalance.png")
