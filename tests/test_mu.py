@@ -744,6 +744,6 @@ def test_fast_sweep_500_frequencies_against_ab13md():
     sw = mu_sweep(sys, S, omega, method="fast", lower="none", refine=False)
     assert sw.peak_upper <= ref.max() * (1 + 1e-6)
     assert np.median(sw.upper / ref) <= 1 + 1e-6
-    # away from the peak the descents stop early: a few points a little above AB13MD
-    assert np.mean(sw.upper > ref * 1.001) < 0.05
-    assert np.all(sw.upper <= ref * 1.2)
+    # within 0.1 % of AB13MD at every frequency (the warm-started descents step on the model of two
+    # coalescing eigenvalues; before, a few points stopped early, up to 3 % above it)
+    assert np.all(sw.upper <= ref * 1.001), np.max(sw.upper / ref)

@@ -379,7 +379,10 @@ class _PointBounds:
             near = min(coords, key=lambda v: abs(np.log(max(v, 1e-300)) - np.log(max(w, 1e-300))))
             warm["x"] = coords[near]
         budget = _GRID_EVALS
-        up, x, B = _fast_at(Mw, structure, params, warm["x"], warm["B"], ftol=1e-9, max_eval=budget)
+        # with the model step where the two largest eigenvalues coalesce (the warm start lands near
+        # the kink the optimum follows along frequency)
+        up, x, B = _fast_at(Mw, structure, params, warm["x"], warm["B"], ftol=1e-9, max_eval=budget,
+                            kinks=True)
         if up.iterations >= budget and x is not None and up.value >= _COLD_BAND * warm["top"]:
             # the warm start did not converge (it can lose its way where the infimum
             # is approached as a real block's d -> 0 and G -> infinity): a cold start
