@@ -288,6 +288,30 @@ def test_default_needs_no_sdp(monkeypatch):
         mu_upper(M, S, method="lmi")
 
 
+def test_scalings_proving_more_than_the_descent_saw_are_kept(monkeypatch):
+    """A descent whose own value is above what its scalings prove (the rounding of a graded form:
+    1e-3 high at d^2 = 4e-14 in a sweep of benchmarks/bench_mu_sweep.py) keeps its scalings and
+    returns the proved value; no LMI is built."""
+    S, _, _ = ab13md_structure(["real", "c1", "full2"])
+    M = crandn(np.random.default_rng(9), S.ncols, S.nrows)
+    good = mu_upper(M, S)
+    real_fast = upper_module._fast_default
+
+    def high(*args, **kw):
+        up, x = real_fast(*args, **kw)
+        up.value *= 1.001                    # claimed above what its scalings prove
+        return up, x
+
+    def no_lmi(*args, **kw):
+        raise AssertionError("the LMI was built")
+    monkeypatch.setattr(upper_module, "_fast_default", high)
+    monkeypatch.setattr(lmi_module, "_lmi_problem", no_lmi)
+    up = mu_upper(M, S)
+    assert up.method == "fast-dg"
+    _certified(M, S, up)
+    assert up.value == pytest.approx(good.value, rel=1e-12)
+
+
 def test_failed_certificate_falls_back_to_the_lmi(monkeypatch):
     S, _, _ = ab13md_structure(["real", "c1", "full2"])
     M = crandn(np.random.default_rng(9), S.ncols, S.nrows)
