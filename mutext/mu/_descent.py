@@ -154,7 +154,8 @@ def _model_search(fun, x, f, d, pred, max_step, cluster, B):
             if clt is not None and clt[1] is not None:
                 d2, pred2 = _cluster_step(clt, B)
                 if pred2 < 0 and np.all(np.isfinite(d2)):
-                    x2 = xt + d2
+                    big = _absmax(d2)
+                    x2 = xt + (d2 * (max_step / big) if big > max_step else d2)
                     f2, g2 = fun(x2)
                     nev += 1
                     if f2 <= f + 1e-4 * pred:
@@ -203,8 +204,8 @@ def _bfgs(fun, x0, B0=None, max_iter: int = 100, ftol: float = 1e-10, max_step: 
     the largest eigenvalue) or ``"budget"``; ``info["moved"]`` whether any step was taken.
     ``cluster`` (optional) returns the model of the two largest eigenvalues at the point
     last evaluated (see :func:`_cluster_step`); where their gap is below ``_CLUSTER_GAP``
-    the step is taken on that model (Armijo backtracking on its predicted decrease), with
-    the gradient step as fallback.  ``noise`` (optional) returns the rounding noise of ``f`` at
+    the step is taken on that model (Armijo backtracking on its predicted decrease,
+    :func:`_model_search`; no BFGS update from it), with the gradient step as fallback.  ``noise`` (optional) returns the rounding noise of ``f`` at
     the point last evaluated: a step gaining less than ``_NOISE_FACTOR`` times it counts as
     gaining less than ``ftol`` (a descent in rounding noise only wanders).  ``hessian``
     (optional, with ``B0`` None) returns the Hessian of ``f`` at the point last evaluated (or

@@ -68,8 +68,6 @@ class _DGParams:
             self.gcol = np.array([S.col_slices[k].start for k in self.real_idx], int)
             self.El = np.eye(self.m)[S.col_block]
             self.Er = np.eye(self.m)[S.row_block]
-            # d A / d x_k = A * sel[k] for the log scaling x_k of block k (A = E_l M E_r^-1)
-            self.sel = self.El.T[:, :, None] - self.Er.T[:, None, :]
             self.yidx = np.arange(self.nreal)
 
     #: relative rounding noise of the last value (see value_grad)
