@@ -155,6 +155,26 @@ def test_zigzag_across_a_kink_turns_to_the_model_step():
     assert up.iterations <= 30
 
 
+def _scaled_form_eigenvalues(x, M, S, beta0, real):
+    """Eigenvalues of the congruent form A^H A + j(GA - A^H G^H) at the descent's coordinates x
+    (log d per block, then the sinh coordinate of G-hat for each block index in ``real``), built
+    here from the definition."""
+    d = np.exp(x[:len(S)])
+    A = (d[S.col_block][:, None] * M) / d[S.row_block][None, :]
+    G = np.zeros((S.nrows, S.ncols), complex)
+    for j, k in enumerate(real):
+        G[S.row_slices[k].start, S.col_slices[k].start] = beta0 * np.sinh(x[len(S) + j])
+    GA = G @ A
+    return np.linalg.eigvalsh(A.conj().T @ A + 1j * (GA - GA.conj().T))
+
+
+def _central_hessian(f, x, h=1e-4):
+    """The Hessian of the scalar function f at x by central differences."""
+    E = np.eye(x.size) * h
+    return np.array([[(f(x + E[i] + E[k]) - f(x + E[i] - E[k]) - f(x - E[i] + E[k]) + f(x - E[i] - E[k]))
+                      / (4 * h * h) for k in range(x.size)] for i in range(x.size)])
+
+
 def test_cluster_hessian_against_finite_differences():
     """The Hessian of the cluster's Lagrangian with U = I/2 is the Hessian of the mean of the two
     largest eigenvalues, a smooth function while they stay apart from the rest: compared with
@@ -168,25 +188,10 @@ def test_cluster_hessian_against_finite_differences():
         x = 0.5 * rng.standard_normal(p.size)
         beta0 = 1.3
         real = [k for k, b in enumerate(S.blocks) if b.kind == "real"]
-
-        def mean_top_two(x):
-            d = np.exp(x[:len(S)])
-            A = (d[S.col_block][:, None] * M) / d[S.row_block][None, :]
-            G = np.zeros((S.nrows, S.ncols), complex)
-            for j, k in enumerate(real):
-                G[S.row_slices[k].start, S.col_slices[k].start] = beta0 * np.sinh(x[len(S) + j])
-            GA = G @ A
-            w = np.linalg.eigvalsh(A.conj().T @ A + 1j * (GA - GA.conj().T))
-            return 0.5 * (w[-1] + w[-2]), w[-1]
-
         p.want_cluster = True
         p.value_grad(x, M, beta0)
-        W = p.cluster_hessian(0.5 * np.eye(2)) * mean_top_two(x)[1]
-        h, N = 1e-4, p.size
-        E = np.eye(N) * h
-        fd = np.array([[(mean_top_two(x + E[i] + E[k])[0] - mean_top_two(x + E[i] - E[k])[0]
-                         - mean_top_two(x - E[i] + E[k])[0] + mean_top_two(x - E[i] - E[k])[0]) / (4 * h * h)
-                        for k in range(N)] for i in range(N)])
+        W = p.cluster_hessian(0.5 * np.eye(2)) * _scaled_form_eigenvalues(x, M, S, beta0, real)[-1]
+        fd = _central_hessian(lambda y: _scaled_form_eigenvalues(y, M, S, beta0, real)[-2:].mean(), x)
         assert np.abs(W - fd).max() <= 1e-6 * np.abs(fd).max(), kinds
 
 
@@ -204,23 +209,9 @@ def test_hessian_of_the_top_eigenvalue_against_finite_differences():
         x = 0.5 * rng.standard_normal(p.size)
         beta0 = 1.3
         real = [k for k, b in enumerate(S.blocks) if b.kind == "real" and use_g]
-
-        def log_top(x):
-            d = np.exp(x[:len(S)])
-            A = (d[S.col_block][:, None] * M) / d[S.row_block][None, :]
-            G = np.zeros((S.nrows, S.ncols), complex)
-            for j, k in enumerate(real):
-                G[S.row_slices[k].start, S.col_slices[k].start] = beta0 * np.sinh(x[len(S) + j])
-            GA = G @ A
-            return np.log(np.linalg.eigvalsh(A.conj().T @ A + 1j * (GA - GA.conj().T))[-1])
-
         p.value_grad(x, M, beta0)
         W = p.hessian()
-        h, N = 1e-4, p.size
-        E = np.eye(N) * h
-        fd = np.array([[(log_top(x + E[i] + E[k]) - log_top(x + E[i] - E[k])
-                         - log_top(x - E[i] + E[k]) + log_top(x - E[i] - E[k])) / (4 * h * h)
-                        for k in range(N)] for i in range(N)])
+        fd = _central_hessian(lambda y: np.log(_scaled_form_eigenvalues(y, M, S, beta0, real)[-1]), x)
         assert np.abs(W - fd).max() <= 1e-6 * np.abs(fd).max(), kinds
 
 
@@ -288,23 +279,30 @@ def test_default_needs_no_sdp(monkeypatch):
         mu_upper(M, S, method="lmi")
 
 
-def test_scalings_proving_more_than_the_descent_saw_are_kept(monkeypatch):
-    """A descent whose own value is above what its scalings prove (the rounding of a graded form:
-    1e-3 high at d^2 = 4e-14 in a sweep of benchmarks/bench_mu_sweep.py) keeps its scalings and
-    returns the proved value; no LMI is built."""
+def _descent_claiming(monkeypatch, factor):
+    """(M, S, the default bound) for a real, a complex and a full block, with the default's descent
+    then patched to claim ``factor`` times the value its scalings prove."""
     S, _, _ = ab13md_structure(["real", "c1", "full2"])
     M = crandn(np.random.default_rng(9), S.ncols, S.nrows)
     good = mu_upper(M, S)
     real_fast = upper_module._fast_default
 
-    def high(*args, **kw):
+    def claimed(*args, **kw):
         up, x = real_fast(*args, **kw)
-        up.value *= 1.001                    # claimed above what its scalings prove
+        up.value *= factor
         return up, x
+    monkeypatch.setattr(upper_module, "_fast_default", claimed)
+    return M, S, good
+
+
+def test_scalings_proving_more_than_the_descent_saw_are_kept(monkeypatch):
+    """A descent whose own value is above what its scalings prove (the rounding of a graded form:
+    1e-3 high at d^2 = 4e-14 in a sweep of benchmarks/bench_mu_sweep.py) keeps its scalings and
+    returns the proved value; no LMI is built."""
+    M, S, good = _descent_claiming(monkeypatch, 1.001)
 
     def no_lmi(*args, **kw):
         raise AssertionError("the LMI was built")
-    monkeypatch.setattr(upper_module, "_fast_default", high)
     monkeypatch.setattr(lmi_module, "_lmi_problem", no_lmi)
     up = mu_upper(M, S)
     assert up.method == "fast-dg"
@@ -313,16 +311,7 @@ def test_scalings_proving_more_than_the_descent_saw_are_kept(monkeypatch):
 
 
 def test_failed_certificate_falls_back_to_the_lmi(monkeypatch):
-    S, _, _ = ab13md_structure(["real", "c1", "full2"])
-    M = crandn(np.random.default_rng(9), S.ncols, S.nrows)
-    good = mu_upper(M, S)
-    real_fast = upper_module._fast_default
-
-    def wrong(*args, **kw):
-        up, x = real_fast(*args, **kw)
-        up.value *= 0.9                      # a value its scalings do not certify
-        return up, x
-    monkeypatch.setattr(upper_module, "_fast_default", wrong)
+    M, S, good = _descent_claiming(monkeypatch, 0.9)      # a value its scalings do not certify
     up = mu_upper(M, S)
     assert up.method == "lmi-dg"
     _certified(M, S, up)
