@@ -355,20 +355,18 @@ class _DGParams:
             self.noise = _EPS * S.nrows * max(-float(w[0]), lam) / lam if lam > 0 else np.inf
             if not grad:
                 return lam, None
+            # d c_{m+j} / d y_j of the G-hat terms
+            cp = (beta0 * np.cosh(x[m:])) * e2[self.real_idx] if self.nreal else None
             if self.want_cluster:
                 # kept for the model of the top two eigenvalues, built only where they are close
-                self.cluster = (w, V, coef, ri, (beta0 * np.cosh(x[m:])) * e2[self.real_idx] if self.nreal else None, x)
+                self.cluster = (w, V, coef, ri, cp, x)
             # d/dx of u^H (sum c_i S_i) u with u = r o v: the coefficients' own (2 c_i q_i on
             # their block) and -2 lambda |v|^2 over the block's rows from r
             u = ri * v
             Su = self._stack_m @ u
             q = (Su @ u.conj()).real
             gx = (coef * q) @ self._map2 - lam * ((v.real * v.real + v.imag * v.imag) @ self._er2)
-            if self.nreal:
-                cp = (beta0 * np.cosh(x[m:])) * e2[self.real_idx]
-                g = np.concatenate((gx, cp * q[m:]))
-            else:
-                cp, g = None, gx
+            g = np.concatenate((gx, cp * q[m:])) if self.nreal else gx
             g = g / max(lam, 1e-300)
             self._last = (w, V, u, Su, q, coef, ri, cp, g)
             return lam, g
