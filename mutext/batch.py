@@ -71,15 +71,14 @@ def _files(folder: Path) -> list[str]:
 
 def _one(folder: str, out_name: str, mbi: bool) -> dict:
     """Diagnose one data set and write its report; never raises (failures are rows too)."""
-    from threadpoolctl import threadpool_limits
-
     from .diagnose import diagnose
+    from .lti import blas_single_thread
     from .report import write_diagnosis
     d = Path(folder)
     row = {"data_set": str(d), "status": "ok"}
     t0 = time.perf_counter()
     try:
-        with threadpool_limits(1, "blas"):
+        with blas_single_thread():
             res = diagnose(str(d / "model.toml"), _files(d / "measured"), validate=_files(d / "validate") or None,
                            repeat=_files(d / "repeat") or None, mbi=mbi)
             write_diagnosis(res, d / out_name)

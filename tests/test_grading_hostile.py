@@ -282,3 +282,39 @@ def test_package_only_on_pythonpath(tmp_path):
     assert len(parts) == len(runs), out.stdout
     for (sub, total), text in zip(runs, parts):
         assert total in text and text.count("Total: ") == 1, text
+
+
+LIBRARY_CALLS = '''
+import ctypes
+
+
+def dk_peak():
+    import control as ct
+    from mutext.dk import dk_iteration
+    from mutext.mu import Block, BlockStructure
+    G = ct.tf([-6, 3], [50, 15, 1])
+    WI, WP = ct.tf([1, 0.2], [0.5, 1]), ct.tf([0.5, 0.05], [1, 0.01])
+    zero, one = ct.tf([0], [1]), ct.tf([1], [1])
+    rows = [[zero, zero, WI], [WP * G, WP, WP * G], [-G, -one, -G]]
+    P = ct.ss(ct.tf([[r.num[0][0] for r in row] for row in rows], [[r.den[0][0] for r in row] for row in rows]))
+    S = BlockStructure([Block.full(1, 1, "input"), Block.full(1, 1, "performance")])
+    return float(dk_iteration(ct.minreal(P, verbose=False), S, 1, 1, max_iter=1, out=None).mu_upper)
+
+
+def own_ctypes():
+    return float(ctypes.CDLL(None).getpid())
+'''
+
+
+def test_the_library_runs_in_the_child_where_the_submission_may_not_load_native_code(tmp_path):
+    """D-K limits BLAS to one thread through threadpoolctl, which finds the BLAS libraries with ctypes:
+    the child does that before its guard, so the library's D-K runs inside a question, while the
+    submission's own ctypes call is still refused."""
+    sub = tmp_path / "library_calls.py"
+    sub.write_text(LIBRARY_CALLS)
+    res = run_submission(sub, [Job("dk", "dk_peak", "float", [{"args": []}]),
+                               Job("native", "own_ctypes", "float", [{"args": []}])], time_limit=120)
+    dk, native = res.questions["dk"], res.questions["native"]
+    assert dk.status == "ok" and not dk.violations and 0.5 < dk.calls[0]["value"] < 5, (dk, res.stderr_tail)
+    assert native.violations == ["loading native code through ctypes (ctypes.dlopen)"], native
+    assert not native.calls[0]["ok"] and "blocked by the grader" in native.calls[0]["error"], native

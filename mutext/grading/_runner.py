@@ -236,6 +236,12 @@ def serve(req, out):
     import numpy as np
     import scipy.linalg  # noqa: F401
     import control as ct
+    # The library limits BLAS to one thread in D-K and the rotor solvers; its first use finds the loaded
+    # BLAS through ctypes, which the guard refuses to the submission.  Made here, before the guard, later
+    # uses reuse it, and a submission calling those solvers is not blocked for the library's own doing.
+    from mutext.lti import blas_single_thread
+    with blas_single_thread():
+        pass
 
     # A protected module already imported (e.g. pulled in by a package
     # __init__) must not be reachable through sys.modules either.
