@@ -69,6 +69,11 @@ class _DGParams:
             self.El = np.eye(self.m)[S.col_block]
             self.Er = np.eye(self.m)[S.row_block]
             self.yidx = np.arange(self.nreal)
+            # flat indices into an N x N Hessian of the x-x diagonal and the (x_k, y_j), (y_j, x_k),
+            # (y_j, y_j) entries (see _lagrangian_hessian)
+            N, j = self.size, self.m + self.yidx
+            self._hidx = np.concatenate((np.arange(self.m) * (N + 1), self.real_idx * N + j,
+                                         j * N + self.real_idx, j * (N + 1)))
 
     #: relative rounding noise of the last value (see value_grad)
     noise = 0.0
@@ -124,32 +129,39 @@ class _DGParams:
             return r, None, None
         return r, lambda: self._cluster(cl)[1], lambda U: self.cluster_hessian(U, cl)
 
-    def _cluster_terms(self, cl):
-        r"""What the model of the two largest eigenvalues and its Hessian share at the evaluation
-        ``cl`` (kept for the last one asked): Q the two top eigenvectors (largest first), their
-        eigenvalues, :math:`u = RQ`, :math:`P_{\alpha} = \partial_\alpha K\,u` ``(N, n, 2)``,
-        :math:`u^HS_iu` ``(T, 2, 2)``, :math:`Q^HE_\alpha Q` ``(m, 2, 2)`` and the sums of the
-        eigenvalue pairs."""
-        if self._terms is not None and self._terms[0] is cl:
-            return self._terms[1]
-        w, V, coef, ri, cp, _ = cl
+    def _terms(self, w, V, k, coef, ri, cp, Su=None):
+        r"""What the first- and second-order models of the ``k`` largest eigenvalues (1 or 2) are
+        built from: Q the top eigenvectors (largest first), their eigenvalues, :math:`u = RQ`,
+        :math:`P_{\alpha} = \partial_\alpha K\,u` ``(N, n, k)``, :math:`u^HS_iu` ``(T, k, k)``,
+        :math:`Q^HE_\alpha Q` ``(m, k, k)``, the sums of the eigenvalue pairs and the derivatives
+        of the coefficients :math:`\partial_\alpha c_i` ``(N, T)``.  ``Su``: :math:`S_iu` ``(T, n, k)``
+        if already computed."""
         n, m, N = w.size, self.m, self.size
-        Q = V[:, :-3:-1]
-        lq = w[:-3:-1]
+        Q = V[:, :-k - 1:-1]
+        lq = w[:-k - 1:-1]
         uq = ri[:, None] * Q
-        Su = self._stack_m @ uq                                      # (T, n, 2), T = N terms
+        if Su is None:
+            Su = self._stack_m @ uq                                  # (T, n, k), T = N terms
         Dc = np.zeros((N, N))
         Dc[:m] = self._map2.T * coef
         if self.nreal:
             Dc[m + self.yidx, m + self.yidx] = cp
-        P = (Dc @ Su.reshape(N, 2 * n)).reshape(N, n, 2)
+        P = (Dc @ Su.reshape(N, k * n)).reshape(N, n, k)
         Qi = uq.conj().T[None] @ Su
-        EQ = ((Q.conj()[:, :, None] * Q[:, None, :]).reshape(n, 4).T @ self.Er).T.reshape(m, 2, 2)
-        out = (Q, lq, uq, P, Qi, EQ, lq[:, None] + lq[None, :], Dc)
-        self._terms = (cl, out)
+        EQ = ((Q.conj()[:, :, None] * Q[:, None, :]).reshape(n, k * k).T @ self.Er).T.reshape(m, k, k)
+        return Q, lq, uq, P, Qi, EQ, lq[:, None] + lq[None, :], Dc
+
+    def _cluster_terms(self, cl):
+        """:meth:`_terms` of the top two eigenvalues at the evaluation ``cl`` (kept for the last one
+        asked: the model and its Hessian share them)."""
+        if self._kept is not None and self._kept[0] is cl:
+            return self._kept[1]
+        w, V, coef, ri, cp, _ = cl
+        out = self._terms(w, V, 2, coef, ri, cp)
+        self._kept = (cl, out)
         return out
 
-    _terms = None
+    _kept = None
 
     def _cluster(self, cl):
         r"""First-order model of the two largest eigenvalues of H, divided by the largest:
@@ -167,121 +179,92 @@ class _DGParams:
         two largest eigenvalues at the evaluation ``cl`` (default: the last; diagonal scalings;
         Overton's second-order model of a cluster), divided by the largest eigenvalue: all
         coordinates, ``U`` a Hermitian ``2 x 2`` matrix (the multiplier of the cluster, trace 1).
+        See :meth:`_lagrangian_hessian`."""
+        if cl is None:
+            cl = self.cluster
+        w, V, coef, ri, cp, _ = cl
+        return self._lagrangian_hessian(w, V, self._cluster_terms(cl), coef, ri, cp, U) / w[-1]
+
+    def _lagrangian_hessian(self, w, V, terms, coef, ri, cp, U):
+        r""":math:`W_{\alpha\beta}` of the top ``k`` eigenvalues (``k`` the size of ``U``, 1 or 2),
+        from their :meth:`_terms`:
 
         .. math::
             W_{\alpha\beta} = \operatorname{Re}\operatorname{tr}\bigl(U Q^H\partial_{\alpha\beta}H\,Q\bigr)
-            + 2\operatorname{Re}\sum_{l>2}\frac{\operatorname{tr}(U F_{\alpha,l}^H F_{\beta,l})}{\lambda - \lambda_l},
+            + 2\operatorname{Re}\sum_{l>k}\frac{\operatorname{tr}(U F_{\alpha,l}^H F_{\beta,l})}{\lambda - \lambda_l},
             \qquad F_{\alpha,l} = v_l^H\,\partial_\alpha H\,Q,
 
-        with :math:`(\lambda_l, v_l)` the other eigenpairs (:math:`\lambda` the cluster's
-        eigenvalue of each column of :math:`Q`, averaged over the pair ``U`` couples).  In the
-        terms of :meth:`hessian` with :math:`u = RQ`: :math:`F_{\alpha,l} = v_l^H(r\circ P_\alpha)
-        - (\lambda_l+\lambda_b)v_l^HE_\alpha Q`, and :math:`q_a^H\partial_{\alpha\beta}Hq_b` has
-        :math:`\delta_{\alpha\beta}(\lambda_a+\lambda_b)q_a^HE_\alpha q_b`,
-        :math:`(E_\alpha q_a)^HH(E_\beta q_b)` and its mirror, :math:`-(E_\alpha u_a)^HP_{\beta b}
-        - P_{\beta a}^HE_\alpha u_b` and its mirror, and :math:`\sum_i\partial_{\alpha\beta}c_i\,
-        u_a^HS_iu_b`."""
-        if cl is None:
-            cl = self.cluster
-        Q, lq, uq, P, Qi, EQ, ls, Dc = self._cluster_terms(cl)
-        w, V, coef, ri, cp, _ = cl
+        with :math:`(\lambda_l, v_l)` the other eigenpairs (:math:`\lambda` the eigenvalue of each
+        column of :math:`Q`, averaged over the pair ``U`` couples).  With :math:`H = RKR`,
+        :math:`R = \operatorname{diag}(r)`, :math:`K = \sum_i c_iS_i` (see :meth:`_stack`),
+        :math:`u = RQ` and :math:`E_\alpha` the rows of block :math:`\alpha`
+        (:math:`\partial_\alpha R = -E_\alpha R`; zero for a G-hat coordinate):
+        :math:`F_{\alpha,l} = v_l^H(r\circ P_\alpha) - (\lambda_l+\lambda_b)v_l^HE_\alpha Q`, and
+        :math:`q_a^H\partial_{\alpha\beta}Hq_b` has :math:`\delta_{\alpha\beta}(\lambda_a+\lambda_b)
+        q_a^HE_\alpha q_b`, :math:`(E_\alpha q_a)^HH(E_\beta q_b)` and its mirror,
+        :math:`-(E_\alpha u_a)^HP_{\beta b} - P_{\beta a}^HE_\alpha u_b` and its mirror, and
+        :math:`\sum_i\partial_{\alpha\beta}c_i\,u_a^HS_iu_b`."""
+        Q, lq, uq, P, Qi, EQ, ls, _ = terms
+        k = lq.size
         n, m, N = w.size, self.m, self.size
         UT = U.T
-        Z = np.empty((n, 2 * m + 2 * N), complex)
-        Z[:, :2 * m] = (self.Er[:, :, None] * Q[:, None, :]).reshape(n, 2 * m)
-        Z[:, 2 * m:] = (ri[:, None, None] * P.transpose(1, 0, 2)).reshape(n, 2 * N)
+        # one product for V^H E_alpha Q (first k m columns) and V^H (r o P_beta) (the rest)
+        Z = np.empty((n, k * (m + N)), complex)
+        Z[:, :k * m] = (self.Er[:, :, None] * Q[:, None, :]).reshape(n, k * m)
+        Z[:, k * m:] = (ri[:, None, None] * P.transpose(1, 0, 2)).reshape(n, k * N)
         Z = V.conj().T @ Z
-        YQ = Z[:, :2 * m].reshape(n, m, 2)
-        F = Z[:, 2 * m:].reshape(n, N, 2)
+        YQ = Z[:, :k * m].reshape(n, m, k)
+        F = Z[:, k * m:].reshape(n, N, k)
         F[:, :m] -= (w[:, None, None] + lq[None, None, :]) * YQ
-        Fl = F[:-2]
-        dl = 1.0 / (lq[None, :] - w[:-2, None])
+        Fl = F[:-k]
+        dl = 1.0 / (lq[None, :] - w[:-k, None])
         Tw = 0.5 * (dl[:, :, None] + dl[:, None, :]) * UT[None]
         W = 2.0 * ((Fl.conj() @ Tw) @ Fl.transpose(0, 2, 1)).sum(0).real
         A_ = (YQ.conj() @ UT) * w[:, None, None]
-        Z1 = A_.transpose(1, 0, 2).reshape(m, 2 * n) @ YQ.transpose(1, 0, 2).reshape(m, 2 * n).T
+        Z1 = A_.transpose(1, 0, 2).reshape(m, k * n) @ YQ.transpose(1, 0, 2).reshape(m, k * n).T
         W[:m, :m] += (Z1 + Z1.T).real
-        T1 = 2.0 * ((uq.conj()[None] * (P @ U)).sum(2) @ self.Er).real.T
+        T1 = 2.0 * ((uq.conj()[None] * (P @ U)).sum(2) @ self.Er).real.T   # 2 Re (E_alpha u)^H P_beta
         W[:m] -= T1
         W[:, :m] -= T1.T
-        qU = (Qi.reshape(N, 4) @ UT.ravel()).real
+        # the terms on the diagonal and, with G-hat, at (x_k, y_j), (y_j, x_k), (y_j, y_j): by flat index
+        qU = (Qi.reshape(N, k * k) @ UT.ravel()).real
         cq = coef * qU
-        e1 = (EQ.reshape(m, 4) @ (UT * ls).ravel()).real
+        e1 = (EQ.reshape(m, k * k) @ (UT * ls).ravel()).real
         if self.nreal:
             t = 2.0 * cp * qU[m:]
-            W.ravel()[self._hidx(N)] += np.concatenate((e1 + 2.0 * (cq @ self._map2), t, t, cq[m:]))
+            W.ravel()[self._hidx] += np.concatenate((e1 + 2.0 * (cq @ self._map2), t, t, cq[m:]))
         else:
-            W.ravel()[self._hidx(N)] += e1 + 2.0 * (cq @ self._map2)
-        return W / w[-1]
+            W.ravel()[self._hidx] += e1 + 2.0 * (cq @ self._map2)
+        return W
 
     _last = None
+    _ONE = np.ones((1, 1))
 
     def hessian(self):
         r"""Hessian of :math:`\log\lambda_{\max}(H)` at the point last evaluated with its gradient
         (diagonal scalings, all coordinates), or None where the top eigenvalue is not simple.
 
-        With :math:`H = RKR`, :math:`R = \operatorname{diag}(r)`, :math:`K = \sum_i c_iS_i` (see
-        :meth:`_stack`), :math:`u = Rv` and :math:`E_\alpha` the rows of block :math:`\alpha`
-        (:math:`\partial_\alpha R = -E_\alpha R`; zero for a G-hat coordinate), the second derivative
-        of a simple eigenvalue (second-order perturbation theory) is
+        The second derivative of a simple eigenvalue (second-order perturbation theory) is
+        :meth:`_lagrangian_hessian` with ``k = 1``,
 
         .. math::
             \lambda_{\alpha\beta} = v^H\partial_{\alpha\beta}H\,v
             + 2\operatorname{Re}\sum_{l\ne 1}\frac{\overline{F_{l\alpha}}F_{l\beta}}{\lambda-\lambda_l},
-            \qquad F_{l\alpha} = v_l^H\partial_\alpha H\,v
-            = v_l^H(r\circ P_\alpha) - (\lambda+\lambda_l)\,v_l^HE_\alpha v,
 
-        :math:`P_\alpha = \partial_\alpha K\,u`, and :math:`v^H\partial_{\alpha\beta}H\,v =
-        \delta_{\alpha\beta}2\lambda\|E_\alpha v\|^2 + 2\operatorname{Re}(E_\alpha v)^HH(E_\beta v)
-        - 2\operatorname{Re}[(E_\alpha u)^HP_\beta + (E_\beta u)^HP_\alpha]
-        + \sum_i\partial_{\alpha\beta}c_i\,u^HS_iu`.  One evaluation's worth of small products;
-        the descent's first metric (BFGS then starts with the curvature it would otherwise spend
-        its first iterations learning)."""
+        and that of the logarithm is :math:`\lambda_{\alpha\beta}/\lambda - g_\alpha g_\beta`.  One
+        evaluation's worth of small products; the descent's first metric (BFGS then starts with
+        the curvature it would otherwise spend its first iterations learning)."""
         if self._last is None:
             return None
         w, V, u, Su, q, coef, ri, cp, g = self._last
         lam = float(w[-1])
         if not (w.size > 1 and lam > w[-2]):
             return None
-        m, r = self.m, self.nreal
-        N = m + r
-        v = V[:, -1]
-        P = np.empty((N, w.size), complex)
-        P[:m] = (self._map2.T * coef) @ Su
-        if r:
-            P[m:] = cp[:, None] * Su[m:]
-        # one product for V^H E_alpha v (first m columns) and V^H (r o P_beta) (the rest)
-        Z = np.empty((w.size, m + N), complex)
-        Z[:, :m] = v[:, None] * self.Er
-        Z[:, m:] = ri[:, None] * P.T
-        Z = V.conj().T @ Z
-        Y, F = Z[:, :m], Z[:, m:]
-        F[:, :m] -= (lam + w)[:, None] * Y
-        Fo = F[:-1]
-        W = 2.0 * ((Fo.conj().T * (1.0 / (lam - w[:-1]))) @ Fo).real
-        T = 2.0 * ((u.conj()[:, None] * self.Er).T @ P.T).real   # 2 Re (E_alpha u)^H P_beta
-        W[:m, :m] += 2.0 * ((Y.conj().T * w) @ Y).real
-        W[:m] -= T
-        W[:, :m] -= T.T
-        # the terms on the diagonal and, with G-hat, at (x_k, y_j), (y_j, x_k), (y_j, y_j): by flat index
-        cq = coef * q
-        W.ravel()[self._hidx(N)] += np.concatenate(
-            ((v.real * v.real + v.imag * v.imag) @ self._er2 * lam + 2.0 * (cq @ self._map2),
-             2.0 * cp * q[m:], 2.0 * cp * q[m:], cq[m:]) if r else
-            ((v.real * v.real + v.imag * v.imag) @ self._er2 * lam + 2.0 * (cq @ self._map2),))
+        terms = self._terms(w, V, 1, coef, ri, cp, Su=Su[:, :, None])
+        W = self._lagrangian_hessian(w, V, terms, coef, ri, cp, self._ONE)
         W /= lam
         W -= np.multiply.outer(g, g)
         return W if math.isfinite(W.sum()) else None
-
-    def _hidx(self, N):
-        """Flat indices into an N x N array of the x-x diagonal and the (x_k, y_j), (y_j, x_k),
-        (y_j, y_j) entries (see :meth:`hessian`)."""
-        if getattr(self, "_hidx_n", None) != N:
-            m, j = self.m, self.m + self.yidx
-            self._hidx_v = np.concatenate((np.arange(m) * (N + 1), self.real_idx * N + j, j * N + self.real_idx,
-                                           j * (N + 1)))
-            self._hidx_n = N
-        return self._hidx_v
 
     # -- small matrices from coordinates -------------------------------------
     @staticmethod
