@@ -348,21 +348,50 @@ def test_default_sweep_peak_equals_ab13md(plant):
     assert lmi.value == pytest.approx(sw.peak_upper, rel=1e-5)
 
 
-def test_default_sweep_is_as_tight_as_ab13md_at_every_frequency():
-    """The default sweep of benchmarks/bench_mu_sweep.py's problem with seed 1 (10 states, blocks
-    r1 r1 C2x2 C1 C1, 300 frequencies) within 0.1 % of AB13MD at every frequency.  Without the
-    model step in the warm-started descents 6 frequencies were up to 1 % above it; with the model
-    step but a BFGS update from its step across the kink, 1-11 % at many."""
+@pytest.mark.parametrize("seed", [1, 6, 8])
+def test_default_sweep_is_as_tight_as_ab13md_at_every_frequency(seed):
+    """The default sweep of benchmarks/bench_mu_sweep.py's problem (10 states, blocks r1 r1 C2x2 C1 C1,
+    300 frequencies) within 0.01 % of AB13MD at every frequency.  Seed 1: without the model step in
+    the warm-started descents 6 frequencies were up to 1 % above it; with the model step but a BFGS
+    update from its step across the kink, 1-11 % at many.  Seeds 6 and 8: warm starts that ran out
+    of evaluations away from the peak were kept, 0.2-0.8 % above it at 2 frequencies each."""
     ab13md = pytest.importorskip("slycot").ab13md
     S = BlockStructure([Block.real(), Block.real(), Block.full(2), Block.full(1), Block.full(1)])
     nb, it = np.array([1, 1, 2, 1, 1]), np.array([1, 1, 2, 2, 2])
-    sys = _random_stable(np.random.default_rng(1), 10, 6, 6)
+    sys = _random_stable(np.random.default_rng(seed), 10, 6, 6)
     omega = np.logspace(-2, 2, 300)
     H = freqresp(sys, omega)
     ref = np.array([ab13md(H[:, :, k], nb, it)[0] for k in range(omega.size)])
     sw = mu_sweep(sys, S, omega, lower="none", refine=False)
     assert sw.peak_upper == pytest.approx(ref.max(), rel=1e-6)
-    assert np.all(sw.upper <= ref * (1 + 1e-3)), np.max(sw.upper / ref)
+    assert np.all(sw.upper <= ref * (1 + 1e-4)), np.max(sw.upper / ref)
+
+
+def test_a_warm_metric_closed_at_a_kink_is_opened_before_the_next_frequency():
+    """BFGS closes the directions across a kink (their eigenvalues of the inverse Hessian go to 0).
+    A sweep carried such a metric along frequency: a real block's G-hat, near 0 at earlier
+    frequencies, could not move to its optimum 0.18 at this one, and the descent stopped 0.18 %
+    above the bound (70 frequencies of the 500-frequency sweep, up to 0.8 %, after a change of
+    rounding).  Opened (eigenvalues floored at 1e-3 of the largest), it reaches the bound."""
+    from mutext.mu._descent import _opened_metric
+    from mutext.mu._fast import _DGParams, _fast_at
+    S = BlockStructure([Block.real(), Block.real(), Block.full(2), Block.full(1), Block.full(1)])
+    sys = _random_stable(np.random.default_rng(0), 10, 6, 6)
+    M = freqresp(sys, np.logspace(-2, 2, 500)[222:223])[:, :, 0]
+    params = _DGParams(S, True)
+    best, x, _ = _fast_at(M, S, params, None, None, ftol=1e-9, max_eval=300, kinks=True, hessian0=True)
+    assert abs(x[5]) > 0.1                       # the first real block's G-hat at the bound
+    x0 = x.copy()
+    x0[5] = 0.0
+    closed = np.eye(params.size - 1)
+    closed[4, 4] = 1e-9                          # x[5] is the fifth free coordinate (x[4] is fixed)
+    stuck, xs, _ = _fast_at(M, S, params, x0, closed, ftol=1e-9, max_eval=60, kinks=True)
+    assert stuck.value > best.value * 1.001 and abs(xs[5]) < 1e-6
+    opened = _opened_metric(closed)
+    assert np.linalg.eigvalsh(opened).min() == pytest.approx(1e-3)
+    up, xo, _ = _fast_at(M, S, params, x0, opened, ftol=1e-9, max_eval=60, kinks=True)
+    assert up.value <= best.value * (1 + 1e-9)
+    assert xo[5] == pytest.approx(x[5], abs=0.02)
 
 
 @pytest.mark.parametrize("seed", range(12))

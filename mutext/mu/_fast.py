@@ -72,6 +72,7 @@ class _DGParams:
             # flat indices into an N x N Hessian of the x-x diagonal and the (x_k, y_j), (y_j, x_k),
             # (y_j, y_j) entries (see _lagrangian_hessian)
             N, j = self.size, self.m + self.yidx
+            self._dcy = j * (N + 1)
             self._hidx = np.concatenate((np.arange(self.m) * (N + 1), self.real_idx * N + j,
                                          j * N + self.real_idx, j * (N + 1)))
 
@@ -105,12 +106,14 @@ class _DGParams:
             E = np.zeros((n, n), complex)
             E[self.grow[j]] = M[self.gcol[j]]
             St[m + j] = 1j * (E - E.conj().T)
-        self._stack_m, self._sflat, self._stack_of = St, St.reshape(m + r, n * n), M
+        self._stack_m, self._stack_of = St, M
+        self._sflat_r = St.reshape(m + r, n * n).view(float)
         if not hasattr(self, "_map2"):
             mp = np.zeros((m + r, m))
             mp[np.arange(m), np.arange(m)] = 2.0
             mp[m + np.arange(r), self.real_idx] = 2.0
             self._map2, self._er2 = mp, 2.0 * self.Er
+            self._er2d = np.repeat(self._er2, 2, axis=0)       # for |v|^2 from v viewed as floats
 
     def model(self, gap: float):
         """(lambda_2/lambda_1, C, W) at the point last evaluated: C a function returning the
@@ -145,7 +148,7 @@ class _DGParams:
         Dc = np.zeros((N, N))
         Dc[:m] = self._map2.T * coef
         if self.nreal:
-            Dc[m + self.yidx, m + self.yidx] = cp
+            Dc.ravel()[self._dcy] = cp                               # d c_{m+j} / d y_j
         P = (Dc @ Su.reshape(N, k * n)).reshape(N, n, k)
         Qi = uq.conj().T[None] @ Su
         EQ = ((Q.conj()[:, :, None] * Q[:, None, :]).reshape(n, k * k).T @ self.Er).T.reshape(m, k, k)
@@ -324,11 +327,13 @@ class _DGParams:
             e2 = np.exp(2.0 * x[:m])
             ri = np.exp(-x[:m])[S.row_block]
             if self.nreal:
-                gs = beta0 * np.sinh(x[m:])
-                coef = np.concatenate((e2, gs * e2[self.real_idx]))
+                er = e2[self.real_idx]
+                coef = np.concatenate((e2, (beta0 * np.sinh(x[m:])) * er))
             else:
                 coef = e2
-            H = (coef @ self._sflat).reshape(S.nrows, S.nrows) * np.multiply.outer(ri, ri)
+            # real coefficients times the stacked terms as real numbers (no complex copy of coef)
+            H = (coef @ self._sflat_r).view(complex).reshape(S.nrows, S.nrows)
+            H *= np.multiply.outer(ri, ri)
             w, V, info = _zheevd(H)
             if info != 0:
                 raise np.linalg.LinAlgError("eigenvalues of the scaled form did not converge")
@@ -339,7 +344,7 @@ class _DGParams:
             if not grad:
                 return lam, None
             # d c_{m+j} / d y_j of the G-hat terms
-            cp = (beta0 * np.cosh(x[m:])) * e2[self.real_idx] if self.nreal else None
+            cp = (beta0 * np.cosh(x[m:])) * er if self.nreal else None
             if self.want_cluster:
                 # kept for the model of the top two eigenvalues, built only where they are close
                 self.cluster = (w, V, coef, ri, cp, x)
@@ -348,7 +353,9 @@ class _DGParams:
             u = ri * v
             Su = self._stack_m @ u
             q = (Su @ u.conj()).real
-            gx = (coef * q) @ self._map2 - lam * ((v.real * v.real + v.imag * v.imag) @ self._er2)
+            # |v|^2 summed over each block's rows: the squared real and imaginary parts (v is a
+            # contiguous column of zheevd's Fortran-ordered V) against the rows of E_r doubled
+            gx = (coef * q) @ self._map2 - lam * (np.square(v.view(float)) @ self._er2d)
             g = np.concatenate((gx, cp * q[m:])) if self.nreal else gx
             g = g / max(lam, 1e-300)
             self._last = (w, V, u, Su, q, coef, ri, cp, g)

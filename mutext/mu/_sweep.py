@@ -16,6 +16,7 @@ from ..errors import IllPosedError, ModelError, SolverError
 from ..response import frequency_grid, resonance_points
 from ._bounds import _both, _both_lower
 from ._certificate import MuUpper
+from ._descent import _opened_metric
 from ._fast import _DGParams, _fast_at, _fast_polish
 from ._lmi import _lmi_bisect
 from ._lower import mu_lower
@@ -123,9 +124,6 @@ def _local_maxima(values) -> list:
 #: them below half the peak, left values up to 3 % above AB13MD's at 6 of 500 frequencies of
 #: benchmarks/bench_mu_sweep.py; 60 everywhere: 0.03 % at most)
 _GRID_EVALS = 60
-#: fast sweep: an unconverged warm start is repeated from a cold start when its value is
-#: above this fraction of the largest so far
-_COLD_BAND = 0.8
 #: fast sweep: a value this fraction above both neighbours is a spike, redone from their
 #: scalings (at most _SPIKE_MAX, the largest first)
 _SPIKE, _SPIKE_MAX = 1e-3, 12
@@ -336,9 +334,9 @@ def mu_sweep(sys, structure: BlockStructure, omega=None, *, method: str = "auto"
 class _PointBounds:
     """The bounds at single frequencies of :func:`mu_sweep`, kept in ``res`` (frequency ->
     (upper, lower or None)).  With ``method`` "fast" or "auto" the descents are warm-started
-    from the last frequency done (a refinement point from the nearest one), with half the
-    evaluations where the bound was far below the peak so far, a cold start where the warm one
-    did not converge near the peak, and ("auto") every value certified by its scalings, the LMI
+    from the last frequency done (a refinement point from the nearest one) with the last
+    descent's metric (its closed directions opened, :func:`_opened_metric`), a cold start where
+    the warm one did not converge, and ("auto") every value certified by its scalings, the LMI
     where they do not reproduce it."""
 
     def __init__(self, structure: BlockStructure, method: str, real: str, lower: str, rng):
@@ -349,7 +347,7 @@ class _PointBounds:
         if self.fast:
             self.params = _DGParams(structure, real == "dg" and structure.has_real)
             self.coords = {}                 # frequency -> coordinates of its fast scalings
-            self.warm = {"x": None, "B": None, "top": 0.0}
+            self.warm = {"x": None, "B": None}
 
     def forget_warm_start(self) -> None:
         """The next points (refinements) start from the nearest frequency done, not the last."""
@@ -383,11 +381,14 @@ class _PointBounds:
         # the kink the optimum follows along frequency)
         up, x, B = _fast_at(Mw, structure, params, warm["x"], warm["B"], ftol=1e-9, max_eval=budget,
                             kinks=True)
-        if up.iterations >= budget and x is not None and up.value >= _COLD_BAND * warm["top"]:
-            # the warm start did not converge (it can lose its way where the infimum
-            # is approached as a real block's d -> 0 and G -> infinity): a cold start
-            # too, where the value may matter for the peak
-            up2, x2, B2 = _fast_at(Mw, structure, params, None, None, ftol=1e-9, max_eval=4 * _GRID_EVALS)
+        if up.iterations >= budget and x is not None:
+            # the warm start did not converge (it can lose its way where the infimum is approached
+            # as a real block's d -> 0 and G -> infinity): a cold start as mu_upper's, from Osborne
+            # balancing with the exact Hessian and the model step at kinks.  Everywhere, not only
+            # near the peak so far: tried there only, off-peak frequencies stayed up to 1.8 % above
+            # AB13MD (bench_mu_sweep.py seeds 6, 8, 11)
+            up2, x2, B2 = _fast_at(Mw, structure, params, None, None, ftol=1e-9, max_eval=4 * _GRID_EVALS,
+                                   kinks=True, hessian0=True)
             if up2.value < up.value:
                 up, x, B = up2, x2, B2
         if self.checked and _certify(Mw, structure, up) is None:
@@ -395,8 +396,7 @@ class _PointBounds:
             # scalings): the LMI there, and no warm start from them
             up, x, B = mu_upper(Mw, structure, method="lmi", real=self.real), None, None
         coords[float(w)] = x
-        warm["x"], warm["B"] = x, B
-        warm["top"] = max(warm["top"], up.value)
+        warm["x"], warm["B"] = x, _opened_metric(B)
         return up
 
 
