@@ -167,10 +167,9 @@ def _model_search(fun, x, f, d, pred, max_step, cluster, B):
     return x, np.inf, None, nev
 
 
-def _inverse_metric(W):
-    """A positive definite inverse of the symmetric ``W`` (a Hessian): its eigenvalues by absolute
-    value, floored at 1e-3 of the largest (a Newton metric that never points uphill, and bounded
-    along flat or concave directions); None if ``W`` has no positive scale."""
+def _floored_spectrum(W, floor: float = 1e-3):
+    """(eigenvalues, eigenvectors, absolute eigenvalues floored at ``floor`` times the largest) of the
+    symmetric ``W`` (one triangle read); None if they are not finite or ``W`` has no positive scale."""
     q, V, info = _dsyev(W)
     if info != 0 or not np.all(np.isfinite(q)):
         return None
@@ -178,12 +177,22 @@ def _inverse_metric(W):
     top = float(a.max()) if a.size else 0.0
     if not top > 0:
         return None
-    a = np.maximum(a, 1e-3 * top)
+    return q, V, np.maximum(a, floor * top)
+
+
+def _inverse_metric(W):
+    """A positive definite inverse of the symmetric ``W`` (a Hessian): its eigenvalues by absolute
+    value, floored at 1e-3 of the largest (a Newton metric that never points uphill, and bounded
+    along flat or concave directions); None if ``W`` has no positive scale."""
+    sp = _floored_spectrum(W)
+    if sp is None:
+        return None
+    _, V, a = sp
     return (V / a) @ V.T
 
 
-def _opened_metric(B, floor: float = 1e-3):
-    """``B`` (a BFGS inverse Hessian approximation) with its eigenvalues floored at ``floor`` times the
+def _opened_metric(B):
+    """``B`` (a BFGS inverse Hessian approximation) with its eigenvalues floored at 1e-3 of the
     largest, for a descent on another function (a warm start at the next frequency): at a kink
     BFGS closes the directions across it (their eigenvalues go to 0), and carried to where the kink
     has moved a closed direction keeps the descent from following the optimum (bench_mu_sweep
@@ -191,15 +200,13 @@ def _opened_metric(B, floor: float = 1e-3):
     stays None; a metric without a positive scale gives None (the identity)."""
     if B is None:
         return None
-    q, V, info = _dsyev(0.5 * (B + B.T))
-    if info != 0 or not np.all(np.isfinite(q)):
+    sp = _floored_spectrum(B)
+    if sp is None:
         return None
-    top = float(q[-1]) if q.size else 0.0
-    if not top > 0:
-        return None
-    if q[0] >= floor * top:
-        return B
-    return (V * np.maximum(q, floor * top)) @ V.T
+    q, V, a = sp
+    if np.array_equal(q, a):
+        return B                    # positive definite, nothing below the floor: kept as it is
+    return (V * a) @ V.T
 
 
 def _first_metric(B0, hessian, n: int):
