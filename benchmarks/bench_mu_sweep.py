@@ -20,9 +20,14 @@ ratios (median, max, number of frequencies more than 0.1 % above AB13MD) and whe
 (:func:`mutext.mu.dg_bound` of the returned scalings) reproduces the peak, then a
 summary table of the default sweep against AB13MD.
 
+With ``--seeds N`` it prints instead one row for each of the problems of seeds 0 .. N-1 (the
+default sweep and ``method="fast"`` against AB13MD: time ratio, largest pointwise ratio,
+frequencies more than 0.1 % above AB13MD).
+
 Usage::
 
     python benchmarks/bench_mu_sweep.py [--points 500] [--lmi] [--seed 0]
+    python benchmarks/bench_mu_sweep.py --seeds 12 [--points 500]
 """
 from __future__ import annotations
 
@@ -64,12 +69,54 @@ def default_table(entries) -> str:
     return "\n".join(out)
 
 
+def seeds_table(count: int, points: int) -> str:
+    """One row per seed 0 .. count-1: AB13MD's CPU seconds, then for the default sweep and
+    ``method="fast"`` their time ratio to it, the largest ratio of the bounds at one frequency and
+    the number of frequencies more than 0.1 % above AB13MD; the last row sums them up."""
+    from slycot import ab13md
+
+    from mutext.lti import freqresp
+    from mutext.mu import mu_sweep, mu_upper
+    omega = np.logspace(-2, 2, points)
+    mu_upper(np.eye(6), problem(0)[1], method="lmi")      # build the LMI once (cvxpy compile time)
+    hdr = (f"{'seed':>4} {'t_ab13md':>8} {'auto t/t_ab':>11} {'auto max':>10} {'>1.001':>6} "
+           f"{'fast t/t_ab':>11} {'fast max':>10} {'>1.001':>6}")
+    out = [f"{points} frequencies per problem, blocks r1 r1 C2x2 C1 C1", hdr, "-" * len(hdr)]
+    stats = {"auto": [], "fast": []}
+    for seed in range(count):
+        sys, S, nb, it = problem(seed)
+        t0 = time.process_time()
+        H = freqresp(sys, omega)
+        ref = np.array([ab13md(H[:, :, k], nb, it)[0] for k in range(omega.size)])
+        t_ab = time.process_time() - t0
+        row = f"{seed:4d} {t_ab:8.3f}"
+        for method in ("auto", "fast"):
+            t0 = time.process_time()
+            sw = mu_sweep(sys, S, omega, method=method, lower="none", refine=False)
+            t = time.process_time() - t0
+            r = sw.upper / ref
+            stats[method].append((t / t_ab, r.max(), int(np.sum(r > 1.001))))
+            row += f" {t / t_ab:11.2f} {r.max():10.6f} {stats[method][-1][2]:6d}"
+        out.append(row)
+    row = f"{'all':>4} {'':>8}"
+    for method in ("auto", "fast"):
+        ratio, worst, bad = zip(*stats[method])
+        row += f" {np.mean(ratio):7.2f} av {max(worst):10.6f} {sum(bad):6d}"
+    out.append(row)
+    return "\n".join(out)
+
+
 def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     ap.add_argument("--points", type=int, default=500)
     ap.add_argument("--seed", type=int, default=0)
     ap.add_argument("--lmi", action="store_true", help="also the LMI sweep (slow)")
+    ap.add_argument("--seeds", type=int, default=0,
+                    help="instead: the problems of seeds 0 .. SEEDS-1, one row each (auto and fast against AB13MD)")
     args = ap.parse_args(argv)
+    if args.seeds > 0:
+        print(seeds_table(args.seeds, args.points))
+        return 0
 
     from slycot import ab13md
 
