@@ -69,6 +69,13 @@ class _DGParams:
             self.El = np.eye(self.m)[S.col_block]
             self.Er = np.eye(self.m)[S.row_block]
             self.yidx = np.arange(self.nreal)
+            m, r = self.m, self.nreal
+            # d c_i / d x_k of the stacked terms' coefficients over c_i (2 on the term's own block)
+            self._map2 = np.zeros((m + r, m))
+            self._map2[np.arange(m), np.arange(m)] = 2.0
+            self._map2[m + np.arange(r), self.real_idx] = 2.0
+            # 2 E_r with each row twice: |v|^2 over each block's rows from v viewed as floats
+            self._er2d = np.repeat(2.0 * self.Er, 2, axis=0)
             # flat indices into an N x N Hessian of the x-x diagonal and the (x_k, y_j), (y_j, x_k),
             # (y_j, y_j) entries (see _lagrangian_hessian)
             N, j = self.size, self.m + self.yidx
@@ -108,12 +115,6 @@ class _DGParams:
             St[m + j] = 1j * (E - E.conj().T)
         self._stack_m, self._stack_of = St, M
         self._sflat_r = St.reshape(m + r, n * n).view(float)
-        if not hasattr(self, "_map2"):
-            mp = np.zeros((m + r, m))
-            mp[np.arange(m), np.arange(m)] = 2.0
-            mp[m + np.arange(r), self.real_idx] = 2.0
-            self._map2, self._er2 = mp, 2.0 * self.Er
-            self._er2d = np.repeat(self._er2, 2, axis=0)       # for |v|^2 from v viewed as floats
 
     def model(self, gap: float):
         """(lambda_2/lambda_1, C, W) at the point last evaluated: C a function returning the
